@@ -1,0 +1,53 @@
+"""Bushing Explorer's computational core: pure NumPy/SciPy, no user interface.
+
+Dynamic stiffness of carbon-black-filled rubber bushings in torsion and axially, over
+frequency and amplitude, after García Tárrago (KTH, 2006). See MODEL.md for the physics.
+"""
+
+from .bushing import (
+    HistoryResult,
+    LoopResult,
+    StiffnessResult,
+    force_history,
+    loop,
+    shape_factor,
+    stiffness,
+    strain_factor,
+)
+from .design import (
+    PAPER_B,
+    TABLE_1,
+    Design,
+    DesignError,
+    Geometry,
+    Material,
+    dumps_design,
+    loads_design,
+    read_design,
+    write_design,
+)
+from .material import ConvergenceError, equivalent_modulus, equivalent_modulus_time_domain
+
+__all__ = [
+    "PAPER_B",
+    "TABLE_1",
+    "ConvergenceError",
+    "Design",
+    "DesignError",
+    "Geometry",
+    "HistoryResult",
+    "LoopResult",
+    "Material",
+    "StiffnessResult",
+    "dumps_design",
+    "equivalent_modulus",
+    "equivalent_modulus_time_domain",
+    "force_history",
+    "loads_design",
+    "loop",
+    "read_design",
+    "shape_factor",
+    "stiffness",
+    "strain_factor",
+    "write_design",
+]

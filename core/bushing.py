@@ -1,0 +1,424 @@
+"""Bushing dynamic stiffness, hysteresis loops and force histories (eqs 10–18).
+
+======== ================== ======================================================
+symbol   name here          meaning
+======== ================== ======================================================
+ε_eq     strain_factor · x  equivalent strain for the drive x (eq 14 torsion, eq 15 axial)
+K        shape_factor · µ   stiffness from the equivalent modulus (eq 17 torsion, eq 18 axial)
+φ, d     amplitude          peak angle (rad, torsion) or peak displacement (m, axial)
+======== ================== ======================================================
+
+The drive x(t) (angle or displacement) maps to the equivalent strain ε_eq = c·x, the material
+turns that into a stress σ(t), and the moment or force is F = S·σ / (2c), where S is the shape
+factor, so that F = S·µ·x for a purely elastic material.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from . import material as mat
+from .material import REFERENCE_FREQUENCY_HZ
+from .design import Design, Geometry
+from .effects import extended_modulus, inertia_correction, wave_stiffness
+from .slices import continuum_nodes, slice_nodes, solve_series
+
+UNITS = {
+    "axial": {"amplitude": "m", "stiffness": "N/m", "force": "N", "drive": "displacement"},
+    "torsion": {"amplitude": "rad", "stiffness": "N·m/rad", "force": "N·m", "drive": "angle"},
+}
+
+Route = Literal["analytic", "time-domain"]
+ROUTES = ("analytic", "time-domain")
+
+
+def strain_factor(geometry: Geometry, mode: str) -> float:
+    """c with ε_eq = c·x: torsion c = a b / (b² − a²) (eq 14); axial
+    c = 1 / sqrt(2 (b² − a²) ln(b/a)) (eq 15). Units 1/rad or 1/m."""
+    a, b = geometry.inner_radius, geometry.outer_radius
+    if mode == "torsion":
+        return a * b / (b * b - a * a)
+    return 1.0 / np.sqrt(2.0 * (b * b - a * a) * np.log(b / a))
+
+
+def shape_factor(geometry: Geometry, mode: str) -> float:
+    """S with K = S·µ_eq: torsion S = 4π a² b² L / (b² − a²) (eq 17, m³/rad);
+    axial S = 2π L / ln(b/a) (eq 18, m)."""
+    a, b, L = geometry.inner_radius, geometry.outer_radius, geometry.length
+    if mode == "torsion":
+        return 4.0 * np.pi * a * a * b * b * L / (b * b - a * a)
+    return 2.0 * np.pi * L / np.log(b / a)
+
+
+# --------------------------------------------------------------------------------------------
+# Grids and results
+# --------------------------------------------------------------------------------------------
+
+
+def _grid(name: str, values) -> np.ndarray:
+    arr = np.atleast_1d(np.asarray(values, dtype=float))
+    if arr.ndim != 1 or arr.size == 0:
+        raise ValueError(f"{name}: give one or more values")
+    if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise ValueError(f"{name}: every value must be a positive finite number")
+    return arr
+
+
+def _readonly(arr: np.ndarray) -> np.ndarray:
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class StiffnessResult:
+    """Dynamic stiffness on an amplitude × frequency grid.
+
+    ``stiffness[i, j]`` is the complex K at ``amplitude[i]`` and ``frequency_hz[j]``, in
+    ``units["stiffness"]`` (N/m axially, N·m/rad in torsion). Arrays are read-only (they may
+    come from the cache).
+    """
+
+    design: Design
+    frequency_hz: np.ndarray
+    amplitude: np.ndarray
+    stiffness: np.ndarray
+    slices: int | str
+    route: str
+
+    @property
+    def mode(self) -> str:
+        return self.design.mode
+
+    @property
+    def units(self) -> dict[str, str]:
+        return {"frequency_hz": "Hz", **UNITS[self.mode]}
+
+    @property
+    def magnitude(self) -> np.ndarray:
+        return np.abs(self.stiffness)
+
+    @property
+    def loss_factor(self) -> np.ndarray:
+        """η = Im K / Re K (MODEL.md)."""
+        return self.stiffness.imag / self.stiffness.real
+
+    def table(self) -> dict[str, np.ndarray]:
+        """Flat columns in FORMATS.md's order, amplitude by amplitude, each a frequency sweep."""
+        amp, freq = np.meshgrid(self.amplitude, self.frequency_hz, indexing="ij")
+        k = self.stiffness.ravel()
+        return {
+            "frequency_hz": freq.ravel(),
+            "amplitude": amp.ravel(),
+            "stiffness_real": k.real,
+            "stiffness_imag": k.imag,
+            "magnitude": np.abs(k),
+            "loss_factor": k.imag / k.real,
+        }
+
+
+# --------------------------------------------------------------------------------------------
+# Stiffness
+# --------------------------------------------------------------------------------------------
+
+
+def _modulus_time_domain(material, effects, frequency_hz, strain_amplitude):
+    """Time-domain route, point by point (for checks and small grids), broadcast like the
+    analytic :func:`core.material.equivalent_modulus`."""
+    f, e = np.broadcast_arrays(np.asarray(frequency_hz, float), np.asarray(strain_amplitude, float))
+    out = np.empty(f.shape, dtype=complex)
+    for idx in np.ndindex(f.shape):
+        out[idx] = _time_domain_point(material, effects, float(f[idx]), float(e[idx]))
+    return out
+
+
+@functools.lru_cache(maxsize=4096)
+def _time_domain_point(material, effects: tuple, frequency_hz: float, strain_amplitude: float):
+    return mat.equivalent_modulus_time_domain(
+        material, frequency_hz, strain_amplitude, effects={k: dict(v) for k, v in effects}
+    ).modulus
+
+
+_MATERIAL_EFFECTS = ("viscous", "strain_stiffening", "rate_amplitude_coupling")
+
+
+def modulus_function(design: Design, route: str = "analytic"):
+    """µ_eq(frequency_hz, strain_amplitude) of the design's material with its material-level
+    effects, by the chosen route, broadcast over both arguments."""
+    if route == "analytic":
+        base = functools.partial(mat.equivalent_modulus, design.material)
+        effects = design.effect_parameters
+        if any(e in effects for e in _MATERIAL_EFFECTS):
+            return functools.partial(extended_modulus, design.material, effects, base_modulus=base)
+        return base
+    if route == "time-domain":
+        # the time-domain route simulates the material-level effects itself
+        return functools.partial(_modulus_time_domain, design.material, design.effects)
+    raise ValueError(f"route: must be one of {', '.join(ROUTES)}, got {route!r}")
+
+
+def _check_slices(slices) -> int | str:
+    if slices == "continuum":
+        return slices
+    if isinstance(slices, bool) or not isinstance(slices, (int, np.integer)) or slices < 1:
+        raise ValueError(f"slices: must be a whole number ≥ 1 or 'continuum', got {slices!r}")
+    return int(slices)
+
+
+@functools.lru_cache(maxsize=128)
+def _stiffness_cached(design: Design, freq: tuple, amp: tuple, slices, route) -> StiffnessResult:
+    f = np.array(freq)
+    x = np.array(amp)
+    geo, mode = design.geometry, design.mode
+    effects = design.effect_parameters
+    modulus = modulus_function(design, route)
+    c = strain_factor(geo, mode)
+    if "nonuniform_strain" in effects and slices == 1:
+        slices = "continuum"
+    if "wave_effects" in effects:
+        if slices != 1:
+            raise ValueError(
+                "effects.wave_effects: standing waves are computed for the single equivalent "
+                "modulus; they cannot be combined with slices, the continuum or nonuniform_strain"
+            )
+        k = wave_stiffness(
+            mode, geo.inner_radius, geo.outer_radius, geo.length,
+            modulus(f[None, :], c * x[:, None]), f[None, :], effects["wave_effects"]["density"],
+        )
+    elif slices == 1:
+        k = shape_factor(geo, mode) * modulus(f[None, :], c * x[:, None])  # eqs 16–18
+    else:
+        nodes = continuum_nodes(geo, mode) if slices == "continuum" else slice_nodes(geo, mode, slices)
+        ff, xx = np.meshgrid(f, x)  # (A, F)
+        k = solve_series(
+            nodes,
+            drive=xx.ravel(),
+            modulus=lambda eps: modulus(ff.ravel()[:, None], eps),
+            strain_guess=c * xx.ravel(),
+        ).reshape(xx.shape)
+    if "inertia" in effects:
+        k = inertia_correction(k, f[None, :], effects["inertia"]["mass"])
+    if not np.all(np.isfinite(k)):
+        raise ValueError("the stiffness is not finite on this grid (check the design's effects)")
+    return StiffnessResult(design, _readonly(f), _readonly(x), _readonly(k), slices, route)
+
+
+def stiffness(
+    design: Design,
+    frequency_hz,
+    amplitude,
+    *,
+    slices: int | str = 1,
+    route: Route = "analytic",
+) -> StiffnessResult:
+    """Dynamic stiffness K(ω, x̂) of the bushing on the grid amplitude × frequency.
+
+    Parameters
+    ----------
+    design : the bushing (mode, geometry, material).
+    frequency_hz : frequencies in Hz (one or more, > 0).
+    amplitude : drive amplitudes, peak angle in rad (torsion) or peak displacement in m (axial).
+    slices : 1 for the single equivalent modulus (eqs 14–18); N > 1 for N concentric slices of
+        equal radial thickness in series (Paper A); ``"continuum"`` for the limit N → ∞.
+        A design with the ``nonuniform_strain`` effect uses the continuum where 1 is asked.
+    route : ``"analytic"`` (closed-form steady state, fast) or ``"time-domain"`` (the thesis'
+        simulation of the strain history, point by point; slow, for checks).
+
+    Returns a :class:`StiffnessResult`; repeated queries come from a bounded cache.
+    Raises :class:`core.material.ConvergenceError` if an iteration does not converge.
+    """
+    f = _grid("frequency_hz", frequency_hz)
+    x = _grid("amplitude", amplitude)
+    slices = _check_slices(slices)
+    if route not in ROUTES:
+        raise ValueError(f"route: must be one of {', '.join(ROUTES)}, got {route!r}")
+    return _stiffness_cached(design, tuple(f.tolist()), tuple(x.tolist()), slices, route)
+
+
+def cache_info():
+    """Hits and misses of the stiffness cache (a functools.lru_cache, bounded)."""
+    return _stiffness_cached.cache_info()
+
+
+# --------------------------------------------------------------------------------------------
+# Hysteresis loop and force histories
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class LoopResult:
+    """One steady period of the hysteresis loop: drive x(θ) = x̂ sin θ, θ = 2πk/N, k < N.
+
+    Forces in N (axial) or N·m (torsion), displacement in m or rad.
+    """
+
+    design: Design
+    frequency_hz: float
+    amplitude: float
+    phase: np.ndarray
+    displacement: np.ndarray
+    force_elastic: np.ndarray
+    force_viscoelastic: np.ndarray
+    force_friction: np.ndarray
+
+    @property
+    def force(self) -> np.ndarray:
+        return self.force_elastic + self.force_viscoelastic + self.force_friction
+
+    @property
+    def units(self) -> dict[str, str]:
+        return UNITS[self.design.mode]
+
+    def table(self) -> dict[str, np.ndarray]:
+        return {
+            "displacement": self.displacement,
+            "force": self.force,
+            "force_elastic": self.force_elastic,
+            "force_viscoelastic": self.force_viscoelastic,
+            "force_friction": self.force_friction,
+        }
+
+
+def steady_friction_loop(strain_amplitude: float, phase, friction_stress_max, friction_strain_half):
+    """Steady Berg friction stress along ε = ε̂ sin θ, in closed form (MODEL.md, route 2).
+
+    Rising branch (cos θ ≥ 0): σ = σ_fmax [1 − ε½ (1 + x)² / (ε½ (1 + x) + ε̂ + ε)];
+    falling branch: σ(ε) = −σ_rising(−ε); x from :func:`core.material.friction_reversal_ratio`.
+    """
+    phase = np.asarray(phase, dtype=float)
+    eps = strain_amplitude * np.sin(phase)
+    x = mat.friction_reversal_ratio(strain_amplitude / friction_strain_half)
+    h = friction_strain_half
+    rising = np.cos(phase) >= 0.0
+    e = np.where(rising, eps, -eps)
+    branch = friction_stress_max * (1.0 - h * (1.0 + x) ** 2 / (h * (1.0 + x) + strain_amplitude + e))
+    return np.where(rising, branch, -branch)
+
+
+def loop(
+    design: Design,
+    frequency_hz: float,
+    amplitude: float,
+    points: int = 256,
+    *,
+    route: Route = "analytic",
+) -> LoopResult:
+    """One steady period of force (moment) against displacement (angle), branch by branch.
+
+    ``route="analytic"`` builds the steady loop in closed form (elastic line, the fractional
+    ellipse Im(m(iω)^α ε̂ e^{iθ}), the Berg loop of :func:`steady_friction_loop`);
+    ``route="time-domain"`` simulates from rest until the steady state and returns the last
+    period (the same convergence rule as the time-domain modulus).
+    """
+    f = float(_grid("frequency_hz", frequency_hz)[0])
+    xa = float(_grid("amplitude", amplitude)[0])
+    if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 4:
+        raise ValueError(f"points: must be a whole number ≥ 4, got {points!r}")
+    m = design.material
+    effects = design.effect_parameters
+    _refuse_structural_effects(design, "the branch-by-branch hysteresis loop")
+    c = strain_factor(design.geometry, design.mode)
+    scale = shape_factor(design.geometry, design.mode) / (2.0 * c)  # F = S σ / (2c)
+    eps_amp = c * xa
+    theta = 2.0 * np.pi * np.arange(points) / points
+    if route == "analytic":
+        eps = eps_amp * np.sin(theta)
+        el = 2.0 * m.shear_modulus * eps
+        if "strain_stiffening" in effects:
+            el = el * (1.0 + effects["strain_stiffening"]["stiffening"] * eps**2)
+        visco_amp = m.fractional_coefficient * (2j * np.pi * f) ** m.fractional_order
+        visco_amp += 2j * np.pi * f * effects.get("viscous", {}).get("viscosity", 0.0)
+        fr = np.imag(visco_amp * eps_amp * np.exp(1j * theta))
+        fric = steady_friction_loop(eps_amp, theta, m.friction_stress_max, m.friction_strain_half)
+        if "rate_amplitude_coupling" in effects:
+            fric = fric * (f / REFERENCE_FREQUENCY_HZ) ** effects["rate_amplitude_coupling"][
+                "rate_exponent"
+            ]
+    elif route == "time-domain":
+        el, fr, fric = _time_domain_loop(m, effects, f, eps_amp, points)
+    else:
+        raise ValueError(f"route: must be one of {', '.join(ROUTES)}, got {route!r}")
+    return LoopResult(
+        design, f, xa, theta, xa * np.sin(theta), scale * el, scale * fr, scale * fric
+    )
+
+
+def _refuse_structural_effects(design: Design, what: str, allowed=()):
+    for eid in ("inertia", "nonuniform_strain", "wave_effects"):
+        if eid in design.effect_parameters and eid not in allowed:
+            raise ValueError(
+                f"effects.{eid}: {what} is computed from the material branches; it is not "
+                f"available for a design with this effect (use the stiffness instead)"
+            )
+
+
+def _time_domain_loop(material, effects, frequency_hz, eps_amp, points):
+    """Last period of the simulated stresses, on the loop's phase grid θ = 2πk/points."""
+    td = mat.equivalent_modulus_time_domain(material, frequency_hz, eps_amp, effects=effects)
+    n_p = max(td.samples_per_period, points)
+    n_p = int(points * -(-n_p // points))  # a multiple of points
+    n = td.periods * n_p
+    theta = 2.0 * np.pi * np.arange(1, n + 1) / n_p
+    br = mat.branch_stresses(
+        material, eps_amp * np.sin(theta), 1.0 / (frequency_hz * n_p), effects, frequency_hz
+    )
+    # last period, starting at θ ≡ 0: samples n − n_p … n − 1 are θ = 2π(k + 1)/n_p; take
+    # the sample with k + 1 ≡ 0 first
+    last = slice(n - n_p - 1, n - 1)
+    step = n_p // points
+    return (br.elastic[last][::step], br.fractional[last][::step], br.friction[last][::step])
+
+
+@dataclass(frozen=True, eq=False)
+class HistoryResult:
+    """Force (moment) history for a sampled displacement (angle) history, branch by branch."""
+
+    design: Design
+    time_s: np.ndarray
+    displacement: np.ndarray
+    force_elastic: np.ndarray
+    force_viscoelastic: np.ndarray
+    force_friction: np.ndarray
+    force_inertia: np.ndarray  # M·d²x/dt² of the ``inertia`` effect, zero without it
+
+    @property
+    def force(self) -> np.ndarray:
+        return self.force_elastic + self.force_viscoelastic + self.force_friction + self.force_inertia
+
+
+def force_history(design: Design, displacement, dt: float) -> HistoryResult:
+    """Force (N) or moment (N·m) for any displacement (m) or angle (rad) history sampled every
+    ``dt`` seconds, e.g. from a multibody simulation. O(N log N): the fractional memory is an
+    FFT convolution (eq 3), the friction state changes only at reversals (eq 6).
+
+    The history starts from rest in the virgin state at zero displacement; a first sample away
+    from zero is reached by a step from zero. Material-level effects are simulated (except
+    ``rate_amplitude_coupling``, defined for harmonic drives only); ``inertia`` adds M·d²x/dt²
+    to the total force; ``nonuniform_strain`` and ``wave_effects`` are refused.
+    """
+    x = np.asarray(displacement, dtype=float)
+    if x.ndim != 1 or x.size == 0 or not np.all(np.isfinite(x)):
+        raise ValueError("displacement: give a one-dimensional array of finite numbers")
+    if not (np.isfinite(dt) and dt > 0):
+        raise ValueError(f"dt: must be a positive finite number, got {dt!r}")
+    _refuse_structural_effects(design, "the force history", allowed=("inertia",))
+    effects = design.effect_parameters
+    c = strain_factor(design.geometry, design.mode)
+    scale = shape_factor(design.geometry, design.mode) / (2.0 * c)
+    br = mat.branch_stresses(design.material, c * x, dt, effects)
+    inertial = np.zeros_like(x)
+    if "inertia" in effects:  # from rest at zero: x_{-1} = x_{-2} = 0
+        padded = np.concatenate(([0.0, 0.0], x))
+        inertial = effects["inertia"]["mass"] * np.diff(padded, 2) / dt**2
+    return HistoryResult(
+        design,
+        dt * np.arange(x.size),
+        x,
+        scale * br.elastic,
+        scale * br.fractional,
+        scale * br.friction,
+        inertial,
+    )

@@ -1,0 +1,210 @@
+"""The ``bushing`` command line (FORMATS.md): a thin shell over the core.
+
+Bad input exits with status 2 and one readable line on standard error; a computation that
+cannot converge exits with status 1 and one line; no traceback is ever printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import math
+import sys
+from contextlib import contextmanager
+
+import numpy as np
+
+from .bushing import loop, stiffness
+from .design import DesignError, read_design
+from .material import ConvergenceError
+
+NUMBER_FORMAT = "{:.12g}"
+
+
+class InputError(Exception):
+    """Bad input from the command line: exit status 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, status 2 (argparse would print the usage too)
+        raise InputError(f"{self.prog}: {message} (see {self.prog} --help)")
+
+
+def _positive(name):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number, got {text!r}")
+        if not math.isfinite(value) or value <= 0:
+            raise argparse.ArgumentTypeError(f"{name} must be a positive finite number, got {text!r}")
+        return value
+
+    return parse
+
+
+def _count(name, minimum=1):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a whole number, got {text!r}")
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"{name} must be at least {minimum}, got {text!r}")
+        return value
+
+    return parse
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="bushing",
+        description="Dynamic stiffness of filled-rubber bushings (torsion and axial) with the "
+        "Fletcher–Gent amplitude dependence. All numbers SI: m, rad, Pa, Hz, N.",
+    )
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    st = sub.add_parser(
+        "stiffness",
+        help="dynamic stiffness on a frequency × amplitude grid (CSV)",
+        description="Dynamic stiffness on a grid. Writes CSV with columns frequency_hz, "
+        "amplitude, stiffness_real, stiffness_imag, magnitude, loss_factor (one row per "
+        "amplitude and frequency; N/m axially, N·m/rad in torsion).",
+    )
+    st.add_argument("design", metavar="DESIGN.json", help="design file (FORMATS.md)")
+    st.add_argument(
+        "--freq",
+        nargs=3,
+        required=True,
+        metavar=("F1", "F2", "N"),
+        help="N frequencies from F1 to F2 in Hz (linear unless --log)",
+    )
+    st.add_argument("--log", action="store_true", help="space the frequencies logarithmically")
+    st.add_argument(
+        "--amp",
+        nargs="+",
+        required=True,
+        type=_positive("--amp"),
+        metavar="A",
+        help="peak amplitudes: displacement in m (axial) or angle in rad (torsion)",
+    )
+    group = st.add_mutually_exclusive_group()
+    group.add_argument(
+        "--slices",
+        type=_count("--slices"),
+        default=1,
+        metavar="N",
+        help="N concentric slices of equal thickness in series (default 1: eqs 17/18)",
+    )
+    group.add_argument(
+        "--continuum", action="store_true", help="the continuum limit of infinitely many slices"
+    )
+    st.add_argument(
+        "--route",
+        choices=("analytic", "time-domain"),
+        default="analytic",
+        help="analytic steady state (default, fast) or the thesis' time-domain simulation",
+    )
+    st.add_argument("-o", dest="output", metavar="OUT.csv", help="write here, not to stdout")
+
+    lp = sub.add_parser(
+        "loop",
+        help="one steady period of the hysteresis loop (CSV)",
+        description="One steady period of the hysteresis loop, drive x̂ sin(2πk/N), k = 0 … N−1. "
+        "Writes CSV with columns displacement, force, force_elastic, force_viscoelastic, "
+        "force_friction (m or rad; N or N·m).",
+    )
+    lp.add_argument("design", metavar="DESIGN.json", help="design file (FORMATS.md)")
+    lp.add_argument("--freq", required=True, type=_positive("--freq"), metavar="F", help="Hz")
+    lp.add_argument(
+        "--amp", required=True, type=_positive("--amp"), metavar="A", help="peak, m or rad"
+    )
+    lp.add_argument(
+        "--points", type=_count("--points", 4), default=256, metavar="N", help="default 256"
+    )
+    lp.add_argument("-o", dest="output", metavar="OUT.csv", help="write here, not to stdout")
+    return parser
+
+
+def _frequencies(args) -> np.ndarray:
+    f1 = _positive("--freq F1")(args.freq[0])
+    f2 = _positive("--freq F2")(args.freq[1])
+    n = _count("--freq N")(args.freq[2])
+    if n == 1 and f1 != f2:
+        raise InputError("bushing stiffness: --freq with N = 1 needs F1 = F2")
+    return np.geomspace(f1, f2, n) if args.log else np.linspace(f1, f2, n)
+
+
+def _write_csv(columns: dict[str, np.ndarray], output: str | None) -> None:
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(columns)
+    for row in zip(*columns.values()):
+        writer.writerow([NUMBER_FORMAT.format(v) for v in row])
+    if output is None:
+        sys.stdout.write(buf.getvalue())
+        return
+    try:
+        with open(output, "w", encoding="utf-8", newline="") as fh:
+            fh.write(buf.getvalue())
+    except OSError as exc:
+        raise InputError(f"bushing: cannot write {output!r}: {exc.strerror}")
+
+
+def _cmd_stiffness(args) -> None:
+    try:
+        freqs = _frequencies(args)
+    except argparse.ArgumentTypeError as exc:
+        raise InputError(f"bushing stiffness: {exc}")
+    design = read_design(args.design)
+    result = stiffness(
+        design,
+        freqs,
+        args.amp,
+        slices="continuum" if args.continuum else args.slices,
+        route=args.route,
+    )
+    _write_csv(result.table(), args.output)
+
+
+def _cmd_loop(args) -> None:
+    design = read_design(args.design)
+    result = loop(design, args.freq, args.amp, args.points)
+    _write_csv(result.table(), args.output)
+
+
+@contextmanager
+def _one_line_errors():
+    """Map every failure to one line on stderr and an exit status; never a traceback."""
+    try:
+        yield
+    except InputError as exc:
+        _fail(str(exc), 2)
+    except (DesignError, ValueError) as exc:
+        _fail(f"bushing: {exc}", 2)
+    except ConvergenceError as exc:
+        _fail(f"bushing: {exc}", 1)
+    except KeyboardInterrupt:
+        _fail("bushing: interrupted", 130)
+    except Exception as exc:  # the last guard: still one line, never a traceback
+        _fail(f"bushing: internal error ({type(exc).__name__}: {exc})", 1)
+
+
+def _fail(message: str, status: int):
+    sys.stderr.write(" ".join(message.split()) + "\n")
+    raise SystemExit(status)
+
+
+COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop}
+
+
+def main(argv: list[str] | None = None) -> int:
+    with _one_line_errors():
+        args = build_parser().parse_args(argv)
+        COMMANDS[args.command](args)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

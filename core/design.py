@@ -1,0 +1,262 @@
+"""Bushing designs: validated, immutable geometry, material and mode, and the design file.
+
+Symbols (MODEL.md), their names here and units:
+
+====== ========================== ========= =========================================
+symbol name                       unit      meaning
+====== ========================== ========= =========================================
+a      ``inner_radius``           m         inner (bonded) radius
+b      ``outer_radius``           m         outer (bonded) radius, b > a
+L      ``length``                 m         bushing length
+µ      ``shear_modulus``          Pa        elastic shear modulus
+m      ``fractional_coefficient`` Pa·s^α    fractional-derivative coefficient
+α      ``fractional_order``       –         fractional order, 0 < α ≤ 1
+σ_fmax ``friction_stress_max``    Pa        largest friction stress
+ε½     ``friction_strain_half``   –         strain at which half of σ_fmax is built
+====== ========================== ========= =========================================
+
+A value that breaks a rule is refused at the door with a :class:`DesignError` whose message
+names the key (``geometry.outer_radius``) and the rule.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any, Mapping
+
+MODES = ("axial", "torsion")
+
+
+class DesignError(ValueError):
+    """A design value or file breaks a rule; ``key`` names the offending field."""
+
+    def __init__(self, key: str, rule: str):
+        self.key = key
+        self.rule = rule
+        super().__init__(f"{key}: {rule}" if key else rule)
+
+
+def _number(key: str, value: Any) -> float:
+    """Return ``value`` as a finite float or refuse it, naming ``key``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise DesignError(key, f"must be a number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise DesignError(key, f"must be a finite number, got {value!r}")
+    return value
+
+
+def _positive(key: str, value: Any) -> float:
+    value = _number(key, value)
+    if value <= 0.0:
+        raise DesignError(key, f"must be positive, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Bonded radii and length of a cylindrical bushing, in metres."""
+
+    inner_radius: float
+    outer_radius: float
+    length: float
+
+    def __post_init__(self):
+        for f in fields(self):
+            object.__setattr__(self, f.name, _positive(f"geometry.{f.name}", getattr(self, f.name)))
+        if self.outer_radius <= self.inner_radius:
+            raise DesignError(
+                "geometry.outer_radius",
+                f"must be larger than geometry.inner_radius (b > a), got b = {self.outer_radius!r}"
+                f" and a = {self.inner_radius!r}",
+            )
+
+
+@dataclass(frozen=True)
+class Material:
+    """The five parameters of the elastic + fractional + friction model (eqs 1–7), SI units."""
+
+    shear_modulus: float
+    fractional_coefficient: float
+    fractional_order: float
+    friction_stress_max: float
+    friction_strain_half: float
+
+    def __post_init__(self):
+        for f in fields(self):
+            key = f"material.{f.name}"
+            value = getattr(self, f.name)
+            if f.name == "fractional_order":
+                value = _number(key, value)
+                if not 0.0 < value <= 1.0:
+                    raise DesignError(key, f"must lie in (0, 1], got {value!r}")
+            else:
+                value = _positive(key, value)
+            object.__setattr__(self, f.name, value)
+
+
+def _frozen_effects(effects: Mapping[str, Mapping[str, float]]) -> tuple:
+    """Validated effects as a hashable, sorted tuple of (id, ((parameter, value), ...))."""
+    if isinstance(effects, tuple):
+        effects = {eid: dict(params) for eid, params in effects}
+    if isinstance(effects, Mapping) and not effects:
+        return ()
+    from .effects import validate_effects  # the effect library knows its own parameters
+
+    checked = validate_effects(effects)
+    return tuple(sorted((eid, tuple(sorted(p.items()))) for eid, p in checked.items()))
+
+
+@dataclass(frozen=True)
+class Design:
+    """A bushing: mode (``axial`` or ``torsion``), geometry and material, optionally named.
+
+    ``effects`` holds the model extensions of the discrepancy workflow (MODEL.md's table,
+    :mod:`core.effects`); pass a mapping ``{effect_id: {parameter: value}}``: it is validated
+    and frozen into a hashable tuple.
+    """
+
+    mode: str
+    geometry: Geometry
+    material: Material
+    name: str | None = None
+    effects: tuple = field(default=())
+
+    def __post_init__(self):
+        if self.mode not in MODES:
+            raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {self.mode!r}")
+        if not isinstance(self.geometry, Geometry):
+            raise DesignError("geometry", "must be a Geometry")
+        if not isinstance(self.material, Material):
+            raise DesignError("material", "must be a Material")
+        if self.name is not None and not isinstance(self.name, str):
+            raise DesignError("name", f"must be a string, got {self.name!r}")
+        object.__setattr__(self, "effects", _frozen_effects(self.effects))
+
+    @property
+    def effect_parameters(self) -> dict[str, dict[str, float]]:
+        return {eid: dict(params) for eid, params in self.effects}
+
+    def replace(self, **changes) -> "Design":
+        """A copy with top-level fields, or geometry/material fields by their own names, changed."""
+        geo = {k: changes.pop(k) for k in list(changes) if k in _GEOMETRY_KEYS}
+        mat = {k: changes.pop(k) for k in list(changes) if k in _MATERIAL_KEYS}
+        current = {f.name: getattr(self, f.name) for f in fields(self)}
+        current.update(changes)
+        if geo:
+            current["geometry"] = Geometry(**{**as_dict(self.geometry), **geo})
+        if mat:
+            current["material"] = Material(**{**as_dict(self.material), **mat})
+        return Design(**current)
+
+    def to_dict(self) -> dict:
+        """The design-file object of FORMATS.md."""
+        out: dict[str, Any] = {}
+        if self.name is not None:
+            out["name"] = self.name
+        out["mode"] = self.mode
+        out["geometry"] = as_dict(self.geometry)
+        out["material"] = as_dict(self.material)
+        if self.effects:
+            out["effects"] = self.effect_parameters
+        return out
+
+
+_GEOMETRY_KEYS = tuple(f.name for f in fields(Geometry))
+_MATERIAL_KEYS = tuple(f.name for f in fields(Material))
+_TOP_KEYS = ("name", "mode", "geometry", "material", "effects")
+
+
+def as_dict(value) -> dict[str, float]:
+    return {f.name: getattr(value, f.name) for f in fields(value)}
+
+
+def _exact_keys(where: str, obj: Any, allowed: tuple[str, ...], required: tuple[str, ...]):
+    if not isinstance(obj, Mapping):
+        raise DesignError(where, f"must be an object with keys {', '.join(allowed)}")
+    prefix = f"{where}." if where else ""
+    for key in obj:
+        if key not in allowed:
+            raise DesignError(
+                f"{prefix}{key}", f"unknown key (allowed: {', '.join(allowed)})"
+            )
+    for key in required:
+        if key not in obj:
+            raise DesignError(f"{prefix}{key}", "missing (required)")
+
+
+def design_from_dict(data: Any) -> Design:
+    """Build a :class:`Design` from a design-file object (FORMATS.md), refusing anything off."""
+    _exact_keys("", data, _TOP_KEYS, ("mode", "geometry", "material"))
+    _exact_keys("geometry", data["geometry"], _GEOMETRY_KEYS, _GEOMETRY_KEYS)
+    _exact_keys("material", data["material"], _MATERIAL_KEYS, _MATERIAL_KEYS)
+    if not isinstance(data["mode"], str):
+        raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {data['mode']!r}")
+    return Design(
+        mode=data["mode"],
+        geometry=Geometry(**data["geometry"]),
+        material=Material(**data["material"]),
+        name=data.get("name"),
+        effects=data.get("effects", {}),
+    )
+
+
+def loads_design(text: str) -> Design:
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise DesignError("", f"not valid JSON: {exc.msg} at line {exc.lineno} column {exc.colno}")
+    return design_from_dict(data)
+
+
+def read_design(path: str | Path) -> Design:
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise DesignError("", f"cannot read design file {str(path)!r}: {exc.strerror}")
+    except UnicodeDecodeError:
+        raise DesignError("", f"design file {str(path)!r} is not UTF-8 text")
+    try:
+        return loads_design(text)
+    except DesignError as exc:
+        raise DesignError(exc.key, f"{exc.rule} (in {path.name})") from None
+
+
+def dumps_design(design: Design) -> str:
+    return json.dumps(design.to_dict(), indent=2) + "\n"
+
+
+def write_design(design: Design, path: str | Path) -> None:
+    Path(path).write_text(dumps_design(design), encoding="utf-8")
+
+
+# Reference designs of the thesis (MODEL.md, "Reference data").
+PAPER_B = Design(
+    name="VP 40/70120 (Paper B)",
+    mode="axial",
+    geometry=Geometry(inner_radius=0.020, outer_radius=0.035, length=0.090),
+    material=Material(
+        shear_modulus=2.42e6,
+        fractional_coefficient=6.0e5,
+        fractional_order=0.20,
+        friction_stress_max=1.92e4,
+        friction_strain_half=4.0e-3,
+    ),
+)
+
+TABLE_1 = Design(
+    name="Table 1 torsion example (Paper A)",
+    mode="torsion",
+    geometry=Geometry(inner_radius=0.005, outer_radius=0.011, length=0.022),
+    material=Material(
+        shear_modulus=2.0e6,
+        fractional_coefficient=2.0e5,
+        fractional_order=0.40,
+        friction_stress_max=4.0e3,
+        friction_strain_half=1.0e-3,
+    ),
+)

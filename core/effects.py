@@ -1,0 +1,241 @@
+"""Effects the thesis model leaves out: named, parameterised extensions (MODEL.md's table).
+
+Each effect is a small record: its id (as in MODEL.md and the design file's ``effects``
+object), a title, its parameters with units, the physics in plain words and the signature it
+leaves in measured stiffness. How an effect enters the model is in one of three places:
+
+* material level (:func:`extended_modulus`): ``viscous``, ``strain_stiffening``,
+  ``rate_amplitude_coupling`` change µ_eq(ω, ε̂);
+* stiffness level (:mod:`core.bushing`): ``inertia`` (K − ω²M), ``wave_effects`` (standing
+  shear waves, :func:`wave_stiffness`), ``nonuniform_strain`` (the continuum model);
+* the branches themselves: ``friction`` and ``fractional`` are the thesis' own branches, whose
+  parameters live in the design's ``material``; they are named here so that a baseline without
+  them can be extended by them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+import numpy as np
+from scipy import special
+
+from .design import DesignError, Material
+from .material import REFERENCE_FREQUENCY_HZ, friction_modulus
+
+
+@dataclass(frozen=True)
+class Parameter:
+    name: str
+    unit: str  # "axial/torsion" where the unit depends on the mode
+    meaning: str
+
+
+@dataclass(frozen=True)
+class Effect:
+    id: str
+    title: str
+    parameters: tuple[Parameter, ...]
+    physics: str
+    signature: str
+    branch: bool = False  # one of the thesis' own branches (parameters live in `material`)
+
+
+EFFECTS: dict[str, Effect] = {
+    e.id: e
+    for e in (
+        Effect(
+            "friction",
+            "Amplitude dependence (Fletcher–Gent effect)",
+            (
+                Parameter("friction_stress_max", "Pa", "largest friction stress σ_fmax"),
+                Parameter("friction_strain_half", "–", "strain ε½ to build half of σ_fmax"),
+            ),
+            "The carbon-black filler network breaks and re-forms as the rubber is strained: "
+            "a rate-independent friction stress that saturates at σ_fmax (Berg's smooth "
+            "friction).",
+            "Stiffness falls and the loss factor first rises then falls as the amplitude "
+            "grows, at every frequency alike.",
+            branch=True,
+        ),
+        Effect(
+            "fractional",
+            "Frequency dependence (fractional viscoelasticity)",
+            (
+                Parameter("fractional_coefficient", "Pa·s^α", "fractional coefficient m"),
+                Parameter("fractional_order", "–", "fractional order α in (0, 1]"),
+            ),
+            "The rubber's polymer chains relax over a broad spectrum of times, which a "
+            "fractional derivative of order α captures with two numbers.",
+            "Stiffness rises as a power of frequency and the loss factor is nearly constant "
+            "over decades of frequency.",
+            branch=True,
+        ),
+        Effect(
+            "inertia",
+            "Apparent mass seen by the force sensor",
+            (Parameter("mass", "kg/kg·m²", "apparent mass M (kg axially, kg·m² in torsion)"),),
+            "Mass between the rubber and the force sensor (fixture, part of the rubber) is "
+            "accelerated with the drive; its inertial force adds to the rubber's.",
+            "Measured stiffness falls below the model more and more at high frequency, as ω², "
+            "the same at every amplitude; the loss factor rises with it.",
+        ),
+        Effect(
+            "viscous",
+            "Integer-order viscous damping",
+            (Parameter("viscosity", "Pa·s", "viscous coefficient c (σ = c dε/dt)"),),
+            "A damping stress proportional to the strain rate, as from a fluid or a very "
+            "fast relaxation mechanism.",
+            "The loss factor grows in proportion to frequency at every amplitude, more than "
+            "the fractional branch allows.",
+        ),
+        Effect(
+            "strain_stiffening",
+            "Elastic stiffening at large strain",
+            (Parameter("stiffening", "–", "β in σ_el = 2µε(1 + βε²)"),),
+            "The rubber network stiffens as its chains approach their full extension.",
+            "At the largest amplitudes the stiffness is higher than the model, growing with "
+            "the amplitude squared, at every frequency; the loss factor drops there.",
+        ),
+        Effect(
+            "rate_amplitude_coupling",
+            "Friction that stiffens with rate",
+            (Parameter("rate_exponent", "–", "γ in µ_f · (f / 10 Hz)^γ"),),
+            "The filler network's friction is not quite rate independent: it stiffens at "
+            "higher rates, which the separable model (friction independent of frequency) "
+            "cannot show.",
+            "The amplitude dependence is stronger at high frequency than at low: the gap "
+            "between small- and large-amplitude stiffness grows with frequency.",
+        ),
+        Effect(
+            "nonuniform_strain",
+            "Non-homogeneous strain inside the bushing",
+            (),
+            "The strain is not one equivalent value: it varies across the rubber (as 1/r² in "
+            "torsion, 1/r axially), so each layer softens by its own amplitude.",
+            "At amplitudes in the knee of the Fletcher–Gent curve, the measured stiffness "
+            "softens more gradually with amplitude than the single equivalent strain gives.",
+        ),
+        Effect(
+            "wave_effects",
+            "Standing shear waves in the rubber",
+            (Parameter("density", "kg/m³", "rubber density ρ"),),
+            "The rubber's own mass: at high frequency shear waves stand across the rubber "
+            "and the stiffness shows resonances.",
+            "Stiffness departs from the model at the highest frequencies, growing steeply "
+            "(towards a resonance), the same at every amplitude.",
+        ),
+    )
+}
+
+
+def validate_effects(effects: Any) -> dict[str, dict[str, float]]:
+    """Check an ``effects`` object of a design file; return it as plain floats.
+
+    Refuses unknown ids, the branch ids (their parameters belong in ``material``), unknown or
+    missing parameters, non-numbers and negative values, naming the key.
+    """
+    if not isinstance(effects, Mapping):
+        raise DesignError("effects", "must be an object mapping effect ids to their parameters")
+    out: dict[str, dict[str, float]] = {}
+    for eid, params in effects.items():
+        key = f"effects.{eid}"
+        if eid not in EFFECTS:
+            raise DesignError(key, f"unknown effect (known: {', '.join(EFFECTS)})")
+        effect = EFFECTS[eid]
+        if effect.branch:
+            raise DesignError(
+                key, "is a branch of the material model; its parameters belong in material"
+            )
+        if not isinstance(params, Mapping):
+            raise DesignError(key, "must be an object of parameter values")
+        names = [p.name for p in effect.parameters]
+        for name in params:
+            if name not in names:
+                allowed = ", ".join(names) or "none"
+                raise DesignError(f"{key}.{name}", f"unknown parameter (allowed: {allowed})")
+        values = {}
+        for name in names:
+            if name not in params:
+                raise DesignError(f"{key}.{name}", "missing (required)")
+            v = params[name]
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise DesignError(f"{key}.{name}", f"must be a finite number, got {v!r}")
+            if v < 0:
+                raise DesignError(f"{key}.{name}", f"must be ≥ 0, got {v!r}")
+            values[name] = float(v)
+        out[eid] = values
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Material level
+# --------------------------------------------------------------------------------------------
+
+
+def extended_modulus(material: Material, effects: Mapping, frequency_hz, strain_amplitude,
+                     base_modulus):
+    """µ_eq with the material-level effects, broadcast over frequency and strain amplitude:
+
+    µ_eq = µ (1 + ¾ β ε̂²) + m (iω)^α / 2 + i ω c / 2 + µ_f(ε̂) (f / 10 Hz)^γ
+
+    (``strain_stiffening`` β: the first harmonic of 2µε(1 + βε²); ``viscous`` c;
+    ``rate_amplitude_coupling`` γ). ``base_modulus(frequency_hz, strain_amplitude)`` gives the
+    thesis' own µ + m(iω)^α/2 + µ_f, whose parts are then corrected.
+    """
+    f = np.asarray(frequency_hz, dtype=float)
+    eps = np.asarray(strain_amplitude, dtype=float)
+    mu = base_modulus(f, eps)
+    if "strain_stiffening" in effects:
+        beta = effects["strain_stiffening"]["stiffening"]
+        mu = mu + material.shear_modulus * 0.75 * beta * eps**2
+    if "viscous" in effects:
+        mu = mu + 1j * np.pi * f * effects["viscous"]["viscosity"]  # iωc/2
+    if "rate_amplitude_coupling" in effects:
+        gamma = effects["rate_amplitude_coupling"]["rate_exponent"]
+        mu_f = friction_modulus(eps, material.friction_stress_max, material.friction_strain_half)
+        mu = mu + mu_f * ((f / REFERENCE_FREQUENCY_HZ) ** gamma - 1.0)
+    return mu
+
+
+# --------------------------------------------------------------------------------------------
+# Stiffness level
+# --------------------------------------------------------------------------------------------
+
+
+def inertia_correction(stiffness, frequency_hz, mass: float):
+    """K_measured = K − ω² M (M in kg axially, kg·m² in torsion)."""
+    omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
+    return stiffness - omega**2 * mass
+
+
+def wave_stiffness(mode: str, inner_radius, outer_radius, length, modulus, frequency_hz, density):
+    """Stiffness with standing shear waves in the rubber (MODEL.md, ``wave_effects``).
+
+    Axial: w'' + w'/r + k² w = 0, k² = ρω²/µ_eq, w(a) = 0, w(b) = d, so
+    w = A J0(kr) + B Y0(kr) and K = 2π a L µ_eq w'(a) / d.
+    Torsion: v = rθ, v'' + v'/r − v/r² + k² v = 0, v(a) = 0, v(b) = bφ, so
+    v = A J1(kr) + B Y1(kr) and K = 2π a² L µ_eq v'(a) / φ (τ = µ_eq (v' − v/r) at r = a).
+    Tends to eqs 17/18 as ρω²/µ → 0. Broadcast over ``modulus`` and ``frequency_hz``.
+    """
+    a, b, L = inner_radius, outer_radius, length
+    mu = np.asarray(modulus, dtype=complex)
+    omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
+    k = omega * np.sqrt(density / mu)
+    ka, kb = k * a, k * b
+    if mode == "axial":
+        # A J0(ka) + B Y0(ka) = 0, A J0(kb) + B Y0(kb) = 1 (unit drive)
+        j_a, y_a, j_b, y_b = special.jv(0, ka), special.yv(0, ka), special.jv(0, kb), special.yv(0, kb)
+        det = j_a * y_b - j_b * y_a
+        A, B = -y_a / det, j_a / det
+        dw = -k * (A * special.jv(1, ka) + B * special.yv(1, ka))
+        return 2.0 * np.pi * a * L * mu * dw
+    # torsion: v(b) = b per unit angle
+    j_a, y_a, j_b, y_b = special.jv(1, ka), special.yv(1, ka), special.jv(1, kb), special.yv(1, kb)
+    det = j_a * y_b - j_b * y_a
+    A, B = -b * y_a / det, b * j_a / det
+    # d/dr J1(kr) = k J0(kr) − J1(kr)/r, likewise Y1
+    dv = A * (k * special.jv(0, ka) - j_a / a) + B * (k * special.yv(0, ka) - y_a / a)
+    return 2.0 * np.pi * a * a * L * mu * dv

@@ -1,0 +1,325 @@
+"""The separable material model (eqs 1–7): elastic, fractional and Berg friction branches.
+
+Two routes lead to the equivalent complex shear modulus µ_eq(ω, ε̂) = σ̂ / (2 ε̂) (eq 16):
+
+* the **time-domain route**, the thesis' own: drive the branches with ε(t) = ε̂ sin ωt, step the
+  strain history (Grünwald–Letnikov for the fractional branch, Berg's smooth friction with
+  reversal updates) until the steady state is reached, and take the first harmonic;
+* the **analytic steady-state route**: µ_eq = µ + m (iω)^α / 2 + µ_f(ε̂), where the friction
+  modulus µ_f comes from the closed-form steady loop (:func:`friction_modulus_universal`).
+
+Conventions: ε is the tensor shear strain (γ = 2ε), σ = 2µε for the elastic branch; complex
+amplitudes follow ε(t) = Im(ε̂ e^{iωt}), so Im µ_eq ≥ 0 means dissipation. All SI.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Mapping
+
+import numpy as np
+from scipy.signal import oaconvolve
+
+from .design import Material
+
+REFERENCE_FREQUENCY_HZ = 10.0  # rate_amplitude_coupling: µ_f · (f / 10 Hz)^γ
+
+# --------------------------------------------------------------------------------------------
+# Analytic steady-state route
+# --------------------------------------------------------------------------------------------
+
+
+def friction_reversal_ratio(z):
+    """Steady turning-point friction stress in units of σ_fmax, for amplitude z = ε̂/ε½.
+
+    x solves x² + (1 + z) x − z = 0 (MODEL.md); written without cancellation as
+    x = 2z / ((1 + z) + sqrt((1 + z)² + 4z)).
+    """
+    z = np.asarray(z, dtype=float)
+    return 2.0 * z / ((1.0 + z) + np.sqrt((1.0 + z) ** 2 + 4.0 * z))
+
+
+def _log1p_remainder(q):
+    """R(q) = ln(1 + q)/q − 1 + q/2 = q²/3 − q³/4 + …, accurate for all q ≥ 0
+    (a series below q = 0.05, where the direct form cancels)."""
+    q = np.asarray(q, dtype=float)
+    out = np.empty_like(q)
+    small = q < 0.05
+    qs = q[small]
+    series = np.zeros_like(qs)
+    for k in range(17, 2, -1):  # Horner: Σ_{k≥3} (−1)^(k+1) q^(k−2) / k, error < 1e-18
+        series *= qs
+        series += (-1.0) ** (k + 1) / k
+    out[small] = series * qs * qs
+    ql = q[~small]
+    out[~small] = np.log1p(ql) / ql - 1.0 + 0.5 * ql
+    return out
+
+
+def friction_modulus_universal(z):
+    """Universal friction modulus g(z), with µ_f(ε̂) = (σ_fmax/ε½) · g(ε̂/ε½) (MODEL.md).
+
+    The steady symmetric Berg loop between ±ε̂ has the rising branch (ε in units of ε½,
+    σ in units of σ_fmax)  σ = 1 − (1 + x)² / ((1 + x) + z + ε), and the falling branch by
+    symmetry. Its first Fourier coefficient over ε = z sin θ, divided by 2z, integrates in
+    closed form (half-period integrals of 1/(A + z sin θ), A = 1 + x + z):
+
+        Re g = (1 + x)² / ((1 + x + z)² s (1 + s)),  s = sqrt((1 + x)(1 + x + 2z)) / (1 + x + z)
+        Im g = 2 / (π z) · [x (x + z) − (1 + x) R(q)],  q = 2z / (1 + x)
+
+    with R from :func:`_log1p_remainder`. Limits: g → 1/2 as z → 0 (µ_f → σ_fmax/(2ε½));
+    Im g → 2/(π z) as z → ∞ (the Coulomb square loop). Im g ≥ 0.
+
+    Parameters: z, array-like, dimensionless amplitude ε̂/ε½ > 0. Returns complex array.
+    """
+    z = np.asarray(z, dtype=float)
+    x = friction_reversal_ratio(z)
+    c = 1.0 + x
+    cz = c + z
+    s = np.sqrt(c * (c + 2.0 * z)) / cz
+    real = c * c / (cz * cz * s * (1.0 + s))
+    h = x * (x + z) - c * _log1p_remainder(2.0 * z / c)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        imag = np.where(z > 0, (2.0 / np.pi) * h / z, 0.0)
+    return real + 1j * imag
+
+
+def friction_modulus(strain_amplitude, friction_stress_max: float, friction_strain_half: float):
+    """Friction modulus µ_f(ε̂) in Pa for the tensor strain amplitude ε̂ (MODEL.md, route 2)."""
+    eps = np.asarray(strain_amplitude, dtype=float)
+    return friction_stress_max / friction_strain_half * friction_modulus_universal(
+        eps / friction_strain_half
+    )
+
+
+def fractional_modulus(frequency_hz, fractional_coefficient: float, fractional_order: float):
+    """Fractional-branch modulus m (iω)^α / 2 in Pa (eq 5 over 2, since σ = 2µε)."""
+    omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
+    return fractional_coefficient * (1j * omega) ** fractional_order / 2.0
+
+
+def equivalent_modulus(material: Material, frequency_hz, strain_amplitude):
+    """µ_eq(ω, ε̂) = µ + m (iω)^α / 2 + µ_f(ε̂) in Pa, broadcast over the two arrays (eq 16)."""
+    return (
+        material.shear_modulus
+        + fractional_modulus(
+            frequency_hz, material.fractional_coefficient, material.fractional_order
+        )
+        + friction_modulus(
+            strain_amplitude, material.friction_stress_max, material.friction_strain_half
+        )
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Time-domain route: the branches along a sampled strain path
+# --------------------------------------------------------------------------------------------
+
+
+def grunwald_weights(n: int, order: float) -> np.ndarray:
+    """Grünwald–Letnikov weights w_0 … w_{n−1} (eq 3) by the recursion
+    w_0 = 1, w_j = w_{j−1} (j − 1 − α)/j, which never overflows (the Gamma ratio does)."""
+    j = np.arange(1, n, dtype=float)
+    return np.concatenate(([1.0], np.cumprod((j - 1.0 - order) / j)))
+
+
+def fractional_stress(strain, dt: float, fractional_coefficient: float, fractional_order: float):
+    """σ_fr(t_n) ≈ m Δt^(−α) Σ_{j=0..n} w_j ε_{n−j} (eq 3), an FFT convolution: O(N log N).
+
+    The history is taken to start from rest at ε = 0 before the first sample. The sum is
+    first-order accurate at t_n and second-order accurate at the shifted time t_n − αΔt/2.
+    """
+    strain = np.asarray(strain, dtype=float)
+    w = grunwald_weights(strain.size, fractional_order)
+    return fractional_coefficient * dt ** (-fractional_order) * oaconvolve(w, strain)[: strain.size]
+
+
+def friction_stress(strain, friction_stress_max: float, friction_strain_half: float):
+    """Berg's smooth friction stress (eq 6) along a sampled strain path.
+
+        σ_f = σ_fs + (ε − ε_s)(σ_fmax − s σ_fs) / (ε½ (1 − s σ_fs/σ_fmax) + s (ε − ε_s))
+
+    with s = sign(dε/dt) and (ε_s, σ_fs) the last reversal point, updated whenever the strain
+    rate changes sign. The path starts from the virgin state (ε_s = 0, σ_fs = 0) at ε = 0, so a
+    path that starts elsewhere is reached by monotone loading from zero. Rate independent.
+    The state changes only at reversals: segments between them are evaluated vectorized, and
+    the loop runs once per reversal, not once per sample.
+    """
+    eps = np.asarray(strain, dtype=float)
+    smax, ehalf = float(friction_stress_max), float(friction_strain_half)
+    path = np.concatenate(([0.0], eps))
+    step = np.sign(np.diff(path))
+    # a sample that does not move keeps the direction it had (no reversal)
+    moving = step != 0
+    if not moving.any():
+        return np.zeros_like(eps)
+    idx = np.where(moving, np.arange(step.size), 0)
+    np.maximum.accumulate(idx, out=idx)
+    direction = step[idx]
+    first = int(np.argmax(moving))
+    direction[:first] = step[first]
+    # segment starts: the sample before a change of direction is a reversal point
+    change = np.flatnonzero(direction[1:] != direction[:-1]) + 1  # index into eps
+    starts = np.concatenate(([0], change))
+    ends = np.concatenate((change, [eps.size]))
+    out = np.empty_like(eps)
+    eps_s, sig_s = 0.0, 0.0
+    for start, end in zip(starts.tolist(), ends.tolist()):
+        s = direction[start]
+        seg = eps[start:end] - eps_s
+        out[start:end] = sig_s + seg * (smax - s * sig_s) / (ehalf * (1.0 - s * sig_s / smax) + s * seg)
+        if end < eps.size:  # the last sample of this segment is the next reversal point
+            eps_s, sig_s = eps[end - 1], out[end - 1]
+    return out
+
+
+@dataclass(frozen=True)
+class BranchStresses:
+    """Stress histories along one strain path, in Pa: the elastic branch (with
+    ``strain_stiffening``), the viscoelastic branch (fractional, with ``viscous``) and the
+    friction branch (with ``rate_amplitude_coupling``)."""
+
+    elastic: np.ndarray
+    fractional: np.ndarray
+    friction: np.ndarray
+
+    @property
+    def total(self) -> np.ndarray:
+        return self.elastic + self.fractional + self.friction
+
+
+def branch_stresses(
+    material: Material,
+    strain,
+    dt: float,
+    effects: Mapping | None = None,
+    frequency_hz: float | None = None,
+) -> BranchStresses:
+    """Stress of each branch for the sampled strain history ``strain`` (step ``dt`` in s).
+
+    ``effects`` (id → parameters, MODEL.md) adds the material-level extensions in the time
+    domain: σ_el = 2µε(1 + βε²) (``strain_stiffening``), σ += c dε/dt (``viscous``, central
+    differences), σ_f · (f / 10 Hz)^γ (``rate_amplitude_coupling``, which needs the drive
+    frequency ``frequency_hz``: it is defined for harmonic drives only).
+    """
+    strain = np.asarray(strain, dtype=float)
+    effects = effects or {}
+    elastic = 2.0 * material.shear_modulus * strain  # eq 1
+    if "strain_stiffening" in effects:
+        elastic = elastic * (1.0 + effects["strain_stiffening"]["stiffening"] * strain**2)
+    visco = fractional_stress(strain, dt, material.fractional_coefficient, material.fractional_order)
+    if "viscous" in effects:
+        visco = visco + effects["viscous"]["viscosity"] * np.gradient(
+            np.concatenate(([0.0], strain)), dt
+        )[1:]
+    friction = friction_stress(strain, material.friction_stress_max, material.friction_strain_half)
+    if "rate_amplitude_coupling" in effects:
+        if frequency_hz is None:
+            raise ValueError(
+                "effects.rate_amplitude_coupling: defined for harmonic drives only (it scales "
+                "friction by the drive frequency), not for an arbitrary history"
+            )
+        gamma = effects["rate_amplitude_coupling"]["rate_exponent"]
+        friction = friction * (frequency_hz / REFERENCE_FREQUENCY_HZ) ** gamma
+    return BranchStresses(elastic, visco, friction)
+
+
+class ConvergenceError(RuntimeError):
+    """An iteration stopped before meeting its tolerance; no number is returned."""
+
+
+@dataclass(frozen=True)
+class TimeDomainModulus:
+    """µ_eq from the time-domain route, with how it was reached."""
+
+    modulus: complex
+    periods: int
+    samples_per_period: int
+    change: float  # estimated relative change of µ_eq still to come (see _remaining_change)
+
+
+def _remaining_change(h1: complex, h2: complex, h3: complex) -> float:
+    """Relative change still to come after the last period, from the last three periods'
+    harmonics h1 (last), h2, h3, assuming the approach to steady state is at worst geometric
+    with the observed ratio r = |h1 − h2| / |h2 − h3|: remaining ≈ |h1 − h2| r / (1 − r).
+    A change at round-off level counts as converged; a ratio ≥ 1 gives no estimate (inf)."""
+    d1, d2 = abs(h1 - h2), abs(h2 - h3)
+    scale = abs(h1)
+    if d1 <= 1e-13 * scale:
+        return d1 / scale
+    r = d1 / d2 if d2 > 0 else np.inf
+    if r >= 0.999:
+        return np.inf
+    return float(max(d1 * r / (1.0 - r), d1) / scale)
+
+
+def _first_harmonic(signal, theta, weight_shift=0.0):
+    """Complex first harmonic c such that signal ≈ Im(c e^{iθ}) over whole periods."""
+    # signal ≈ a sin θ + b cos θ  ⇒  c = a + i b
+    a = 2.0 * np.mean(signal * np.sin(theta - weight_shift))
+    b = 2.0 * np.mean(signal * np.cos(theta - weight_shift))
+    return a + 1j * b
+
+
+def samples_per_period_for(material: Material, strain_amplitude: float) -> int:
+    """Samples per period resolving the friction knee (width ~ sqrt(2 ε½/ε̂) in phase)."""
+    z = strain_amplitude / material.friction_strain_half
+    knee = np.sqrt(2.0 / max(z, 1e-12))
+    need = 2.0 * np.pi / min(knee / 40.0, 2.0 * np.pi / 1024)
+    return int(4 * 2 ** int(np.ceil(np.log2(need / 4))))
+
+
+def equivalent_modulus_time_domain(
+    material: Material,
+    frequency_hz: float,
+    strain_amplitude: float,
+    *,
+    samples_per_period: int | None = None,
+    periods: int = 8,
+    max_periods: int = 1024,
+    rtol: float = 2e-6,
+    effects: Mapping | None = None,
+) -> TimeDomainModulus:
+    """µ_eq(ω, ε̂) by simulating the strain-driven model (the thesis' route, eq 16).
+
+    ε(t) = ε̂ sin ωt is applied from rest. The fractional memory decays slowly (algebraically)
+    and, at small amplitude, so does the friction loop's drift from the virgin state, so the
+    number of periods doubles until the change still to come is below ``rtol`` (relative to
+    |µ_eq|), or :class:`ConvergenceError` is raised. The GL sum is assigned to its second-order time
+    t_n − αΔt/2 (a phase shift ωαΔt/2 of its harmonic). Convergence is judged on the last three
+    periods (:func:`_remaining_change`).
+    """
+    if not (frequency_hz > 0 and strain_amplitude > 0):
+        raise ValueError("frequency and strain amplitude must be positive")
+    n_p = samples_per_period or samples_per_period_for(material, strain_amplitude)
+    omega = 2.0 * np.pi * frequency_hz
+    dt = 1.0 / (frequency_hz * n_p)
+    shift = omega * material.fractional_order * dt / 2.0
+    total = periods
+    while True:
+        n = total * n_p
+        theta = 2.0 * np.pi * np.arange(1, n + 1) / n_p
+        strain = strain_amplitude * np.sin(theta)
+        br = branch_stresses(material, strain, dt, effects, frequency_hz)
+
+        def modulus(k):  # k-th last period
+            sl = slice(n - k * n_p, n - (k - 1) * n_p)
+            th = theta[sl]
+            stress_amp = (
+                _first_harmonic(br.elastic[sl], th)
+                + _first_harmonic(br.fractional[sl], th, shift)
+                + _first_harmonic(br.friction[sl], th)
+            )
+            return stress_amp / (2.0 * strain_amplitude)
+
+        h1, h2, h3 = modulus(1), modulus(2), modulus(3)
+        change = _remaining_change(h1, h2, h3)
+        if change <= rtol:
+            return TimeDomainModulus(complex(h1), total, n_p, float(change))
+        if total * 2 > max_periods:
+            raise ConvergenceError(
+                f"time-domain steady state not reached at {frequency_hz:g} Hz, strain amplitude "
+                f"{strain_amplitude:g} after {total} periods (estimated remaining change "
+                f"{change:.2e} > {rtol:.1e})"
+            )
+        total *= 2
