@@ -142,8 +142,8 @@ def friction_stress(strain, friction_stress_max: float, friction_strain_half: fl
     with s = sign(dε/dt) and (ε_s, σ_fs) the last reversal point, updated whenever the strain
     rate changes sign. The path starts from the virgin state (ε_s = 0, σ_fs = 0) at ε = 0, so a
     path that starts elsewhere is reached by monotone loading from zero. Rate independent.
-    The state changes only at reversals: segments between them are evaluated vectorized, and
-    the loop runs once per reversal, not once per sample.
+    The state changes only at reversals: a scalar recurrence runs once per reversal to find
+    the reversal states, then eq 6 is evaluated for all samples at once.
     """
     eps = np.asarray(strain, dtype=float)
     smax, ehalf = float(friction_stress_max), float(friction_strain_half)
@@ -158,19 +158,25 @@ def friction_stress(strain, friction_stress_max: float, friction_strain_half: fl
     direction = step[idx]
     first = int(np.argmax(moving))
     direction[:first] = step[first]
-    # segment starts: the sample before a change of direction is a reversal point
+    # segments of monotone motion; the last sample of each is the next reversal point
     change = np.flatnonzero(direction[1:] != direction[:-1]) + 1  # index into eps
     starts = np.concatenate(([0], change))
     ends = np.concatenate((change, [eps.size]))
-    out = np.empty_like(eps)
-    eps_s, sig_s = 0.0, 0.0
-    for start, end in zip(starts.tolist(), ends.tolist()):
-        s = direction[start]
-        seg = eps[start:end] - eps_s
-        out[start:end] = sig_s + seg * (smax - s * sig_s) / (ehalf * (1.0 - s * sig_s / smax) + s * seg)
-        if end < eps.size:  # the last sample of this segment is the next reversal point
-            eps_s, sig_s = eps[end - 1], out[end - 1]
-    return out
+    seg_dir = direction[starts]
+    # the reversal states, one scalar step per segment (plain floats: cheap per reversal)
+    eps_s = np.empty(starts.size)
+    sig_s = np.empty(starts.size)
+    e0, s0 = 0.0, 0.0
+    for k, (s, e1) in enumerate(zip(seg_dir.tolist(), eps[ends - 1].tolist())):
+        eps_s[k], sig_s[k] = e0, s0
+        u = e1 - e0
+        s0 = s0 + u * (smax - s * s0) / (ehalf * (1.0 - s * s0 / smax) + s * u)
+        e0 = e1
+    # eq 6 for every sample at once, with its segment's reversal state
+    seg = np.repeat(np.arange(starts.size), ends - starts)
+    s, es, ss = seg_dir[seg], eps_s[seg], sig_s[seg]
+    u = eps - es
+    return ss + u * (smax - s * ss) / (ehalf * (1.0 - s * ss / smax) + s * u)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,154 @@
+"""The `bushing` command line exactly as FORMATS.md describes it."""
+
+import csv
+import io
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from core import PAPER_B, TABLE_1, loop, stiffness, write_design
+from core.cli import main
+
+STIFFNESS_COLUMNS = ["frequency_hz", "amplitude", "stiffness_real", "stiffness_imag", "magnitude", "loss_factor"]
+LOOP_COLUMNS = ["displacement", "force", "force_elastic", "force_viscoelastic", "force_friction"]
+
+
+@pytest.fixture
+def designs(tmp_path):
+    paths = {}
+    for key, design in (("axial", PAPER_B), ("torsion", TABLE_1)):
+        paths[key] = tmp_path / f"{key}.json"
+        write_design(design, paths[key])
+    return paths
+
+
+def run(argv, capsys):
+    try:
+        status = main([str(a) for a in argv])
+    except SystemExit as exc:
+        status = exc.code
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def read_csv(text):
+    rows = list(csv.reader(io.StringIO(text)))
+    return rows[0], np.array(rows[1:], dtype=float)
+
+
+def test_stiffness_to_stdout(designs, capsys):
+    status, out, err = run(["stiffness", designs["axial"], "--freq", 1, 100, 5, "--amp", 1e-4, 1e-3], capsys)
+    assert status == 0 and err == ""
+    header, data = read_csv(out)
+    assert header == STIFFNESS_COLUMNS and data.shape == (10, 6)
+    ref = stiffness(PAPER_B, np.linspace(1, 100, 5), [1e-4, 1e-3])
+    assert_allclose(data[:, 0], np.tile(np.linspace(1, 100, 5), 2))
+    assert_allclose(data[:, 1], np.repeat([1e-4, 1e-3], 5))
+    assert_allclose(data[:, 2] + 1j * data[:, 3], ref.stiffness.ravel(), rtol=1e-11)
+    assert_allclose(data[:, 4], ref.magnitude.ravel(), rtol=1e-11)
+    assert_allclose(data[:, 5], ref.loss_factor.ravel(), rtol=1e-11)
+
+
+def test_stiffness_log_grid_slices_and_file(designs, capsys, tmp_path):
+    out_path = tmp_path / "k.csv"
+    status, out, _ = run(
+        ["stiffness", designs["torsion"], "--freq", 10, 1000, 3, "--log", "--amp", 1e-3, "--slices", 3, "-o", out_path],
+        capsys,
+    )
+    assert status == 0 and out == ""
+    header, data = read_csv(out_path.read_text())
+    assert_allclose(data[:, 0], [10, 100, 1000])
+    ref = stiffness(TABLE_1, [10, 100, 1000], 1e-3, slices=3)
+    assert_allclose(data[:, 4], ref.magnitude.ravel(), rtol=1e-11)
+
+
+def test_stiffness_continuum_and_time_domain(designs, capsys):
+    _, out, _ = run(["stiffness", designs["axial"], "--freq", 10, 10, 1, "--amp", 2e-4, "--continuum"], capsys)
+    cont = read_csv(out)[1]
+    assert_allclose(cont[0, 4], stiffness(PAPER_B, 10, 2e-4, slices="continuum").magnitude[0, 0], rtol=1e-11)
+    _, out, _ = run(["stiffness", designs["axial"], "--freq", 10, 10, 1, "--amp", 2e-4, "--route", "time-domain"], capsys)
+    td = read_csv(out)[1]
+    assert_allclose(td[0, 4], stiffness(PAPER_B, 10, 2e-4).magnitude[0, 0], rtol=1e-4)
+
+
+def test_loop(designs, capsys):
+    status, out, _ = run(["loop", designs["axial"], "--freq", 0.1, "--amp", 1e-3, "--points", 64], capsys)
+    assert status == 0
+    header, data = read_csv(out)
+    assert header == LOOP_COLUMNS and data.shape == (64, 5)
+    ref = loop(PAPER_B, 0.1, 1e-3, 64)
+    assert_allclose(data[:, 1], ref.force, rtol=1e-11, atol=1e-9)
+    assert_allclose(data[:, 1], data[:, 2:].sum(axis=1), rtol=1e-9, atol=1e-9)
+
+
+def test_loop_default_points(designs, capsys):
+    _, out, _ = run(["loop", designs["torsion"], "--freq", 10, "--amp", 0.01], capsys)
+    assert read_csv(out)[1].shape == (256, 5)
+
+
+def _bad_design(tmp_path, mutate):
+    data = PAPER_B.to_dict()
+    mutate(data)
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(data))
+    return path
+
+
+BAD = [
+    (["stiffness", "{axial}", "--freq", 1, 100, "--amp", 1e-4], "--freq"),
+    (["stiffness", "{axial}", "--freq", 1, 100, 0, "--amp", 1e-4], "--freq"),
+    (["stiffness", "{axial}", "--freq", -1, 100, 5, "--amp", 1e-4], "--freq"),
+    (["stiffness", "{axial}", "--freq", 1, 100, 2.5, "--amp", 1e-4], "--freq"),
+    (["stiffness", "{axial}", "--freq", 1, 100, 5, "--amp", "-1e-4"], "--amp"),
+    (["stiffness", "{axial}", "--freq", 1, 100, 5, "--amp", "abc"], "--amp"),
+    (["stiffness", "{axial}", "--freq", 1, 100, 5], "--amp"),
+    (["stiffness", "{axial}", "--freq", 1, 100, 5, "--amp", 1e-4, "--slices", 0], "--slices"),
+    (["stiffness", "{axial}", "--freq", 1, 100, 5, "--amp", 1e-4, "--slices", 2, "--continuum"], "--continuum"),
+    (["stiffness", "{axial}", "--freq", 1, 100, 5, "--amp", 1e-4, "--route", "magic"], "--route"),
+    (["stiffness", "{axial}", "--freq", 1, 100, 5, "--amp", 1e-4, "-o", "/no/such/dir/k.csv"], "cannot write"),
+    (["stiffness", "missing.json", "--freq", 1, 100, 5, "--amp", 1e-4], "cannot read"),
+    (["stiffness", "{bad}", "--freq", 1, 100, 5, "--amp", 1e-4], "geometry.outer_radius"),
+    (["loop", "{axial}", "--freq", "nan", "--amp", 1e-3], "--freq"),
+    (["loop", "{axial}", "--freq", 1, "--amp", 0], "--amp"),
+    (["loop", "{axial}", "--freq", 1, "--amp", 1e-3, "--points", 2], "--points"),
+    (["loop", "{inertia}", "--freq", 1, "--amp", 1e-3], "effects.inertia"),
+    (["teleport"], "invalid choice"),
+    ([], "required"),
+]
+
+
+@pytest.mark.parametrize("argv,needle", BAD)
+def test_bad_input_is_one_line_and_status_2(argv, needle, designs, capsys, tmp_path):
+    bad = _bad_design(tmp_path, lambda d: d["geometry"].__setitem__("outer_radius", 0.01))
+    inertia = tmp_path / "inertia.json"
+    write_design(PAPER_B.replace(effects={"inertia": {"mass": 1.0}}), inertia)
+    argv = [str(a).format(axial=designs["axial"], bad=bad, inertia=inertia) for a in argv]
+    status, out, err = run(argv, capsys)
+    assert status == 2
+    assert out == ""
+    assert err.count("\n") == 1 and needle in err
+    assert "Traceback" not in err
+
+
+def test_help_exits_zero(capsys):
+    for argv in (["--help"], ["stiffness", "--help"], ["loop", "--help"]):
+        status, out, _ = run(argv, capsys)
+        assert status == 0 and "usage" in out
+
+
+def test_installed_entry_point_runs_without_traceback(designs, tmp_path):
+    """The console script as a user types it, in a separate process."""
+    ok = subprocess.run(
+        [sys.executable, "-m", "core.cli", "stiffness", str(designs["axial"]), "--freq", "1", "10", "2", "--amp", "1e-4"],
+        capture_output=True, text=True,
+    )
+    assert ok.returncode == 0 and ok.stdout.splitlines()[0] == ",".join(STIFFNESS_COLUMNS)
+    bad = subprocess.run(
+        [sys.executable, "-m", "core.cli", "loop", str(tmp_path / "none.json"), "--freq", "1", "--amp", "1e-3"],
+        capture_output=True, text=True,
+    )
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "Traceback" not in bad.stderr

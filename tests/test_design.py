@@ -1,0 +1,202 @@
+"""Designs and the design file: round trips and every refusal, naming key and rule."""
+
+import copy
+import json
+import math
+
+import pytest
+
+from core import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material, loads_design
+from core.design import dumps_design, read_design, write_design
+
+
+def paper_b_dict():
+    return copy.deepcopy(PAPER_B.to_dict())
+
+
+@pytest.mark.parametrize("design", [PAPER_B, TABLE_1])
+def test_round_trip_through_file(tmp_path, design):
+    path = tmp_path / "d.json"
+    write_design(design, path)
+    assert read_design(path) == design
+    assert loads_design(dumps_design(design)) == design
+
+
+def test_format_example_of_formats_md_reads():
+    text = """{
+      "name": "VP 40/70120 (Paper B)",
+      "mode": "axial",
+      "geometry": {"inner_radius": 0.020, "outer_radius": 0.035, "length": 0.090},
+      "material": {"shear_modulus": 2.42e6, "fractional_coefficient": 6.0e5,
+        "fractional_order": 0.20, "friction_stress_max": 1.92e4, "friction_strain_half": 4.0e-3}
+    }"""
+    assert loads_design(text) == PAPER_B
+
+
+def test_name_is_optional_and_integers_are_numbers():
+    data = paper_b_dict()
+    del data["name"]
+    data["material"]["fractional_order"] = 1
+    design = loads_design(json.dumps(data))
+    assert design.name is None and design.material.fractional_order == 1.0
+
+
+def test_designs_are_immutable_and_hashable():
+    with pytest.raises(AttributeError):
+        PAPER_B.geometry.length = 1.0
+    assert hash(PAPER_B) == hash(loads_design(dumps_design(PAPER_B)))
+
+
+def _refusal(mutate):
+    data = paper_b_dict()
+    mutate(data)
+    with pytest.raises(DesignError) as info:
+        loads_design(json.dumps(data))
+    return info.value
+
+
+GEOMETRY_KEYS = ["inner_radius", "outer_radius", "length"]
+MATERIAL_POSITIVE = [
+    "shear_modulus",
+    "fractional_coefficient",
+    "friction_stress_max",
+    "friction_strain_half",
+]
+
+
+@pytest.mark.parametrize("key", GEOMETRY_KEYS)
+@pytest.mark.parametrize("value", [0.0, -0.01])
+def test_non_positive_sizes_refused(key, value):
+    err = _refusal(lambda d: d["geometry"].__setitem__(key, value))
+    assert err.key == f"geometry.{key}"
+    assert "positive" in str(err) and key in str(err)
+
+
+@pytest.mark.parametrize("key", MATERIAL_POSITIVE)
+@pytest.mark.parametrize("value", [0.0, -1.0])
+def test_non_positive_moduli_refused(key, value):
+    err = _refusal(lambda d: d["material"].__setitem__(key, value))
+    assert err.key == f"material.{key}" and "positive" in str(err)
+
+
+@pytest.mark.parametrize("outer", [0.020, 0.019])
+def test_outer_not_beyond_inner_refused(outer):
+    err = _refusal(lambda d: d["geometry"].__setitem__("outer_radius", outer))
+    assert err.key == "geometry.outer_radius" and "b > a" in str(err)
+
+
+@pytest.mark.parametrize("alpha", [0.0, -0.2, 1.0000001, 2.0])
+def test_fractional_order_outside_unit_interval_refused(alpha):
+    err = _refusal(lambda d: d["material"].__setitem__("fractional_order", alpha))
+    assert err.key == "material.fractional_order" and "(0, 1]" in str(err)
+
+
+def test_fractional_order_one_accepted():
+    Material(2e6, 1e5, 1.0, 1e4, 1e-3)
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), "2e6", None, True, [1]])
+def test_non_numbers_and_non_finite_refused(value):
+    err = _refusal(lambda d: d["material"].__setitem__("shear_modulus", value))
+    assert err.key == "material.shear_modulus"
+
+
+def test_nan_in_json_text_refused():
+    text = dumps_design(PAPER_B).replace("0.09", "NaN")
+    with pytest.raises(DesignError, match="geometry.length"):
+        loads_design(text)
+
+
+@pytest.mark.parametrize(
+    "section,key", [("geometry", k) for k in GEOMETRY_KEYS] + [("material", "fractional_order")]
+)
+def test_missing_keys_refused(section, key):
+    err = _refusal(lambda d: d[section].pop(key))
+    assert err.key == f"{section}.{key}" and "missing" in str(err)
+
+
+@pytest.mark.parametrize("top", ["mode", "geometry", "material"])
+def test_missing_top_level_keys_refused(top):
+    err = _refusal(lambda d: d.pop(top))
+    assert err.key == top and "missing" in str(err)
+
+
+@pytest.mark.parametrize(
+    "where,mutate",
+    [
+        ("colour", lambda d: d.__setitem__("colour", "black")),
+        ("geometry.width", lambda d: d["geometry"].__setitem__("width", 0.01)),
+        ("material.density", lambda d: d["material"].__setitem__("density", 1100)),
+    ],
+)
+def test_unknown_keys_refused(where, mutate):
+    err = _refusal(mutate)
+    assert err.key == where and "unknown key" in str(err)
+
+
+@pytest.mark.parametrize("mode", ["radial", "", 3, None])
+def test_bad_mode_refused(mode):
+    err = _refusal(lambda d: d.__setitem__("mode", mode))
+    assert err.key == "mode" and "axial" in str(err)
+
+
+@pytest.mark.parametrize("text", ["", "{", "[1, 2]", '"design"'])
+def test_not_a_design_object_refused(text):
+    with pytest.raises(DesignError):
+        loads_design(text)
+
+
+def test_unreadable_file_refused(tmp_path):
+    with pytest.raises(DesignError, match="cannot read"):
+        read_design(tmp_path / "missing.json")
+    bad = tmp_path / "bad.json"
+    bad.write_bytes(b"\xff\xfe\x00")
+    with pytest.raises(DesignError):
+        read_design(bad)
+
+
+def test_api_refuses_at_the_door():
+    with pytest.raises(DesignError, match="geometry.outer_radius"):
+        Geometry(0.02, 0.01, 0.05)
+    with pytest.raises(DesignError, match="geometry.length"):
+        Geometry(0.01, 0.02, math.nan)
+    with pytest.raises(DesignError, match="mode"):
+        Design("shear", PAPER_B.geometry, PAPER_B.material)
+
+
+def test_replace_revalidates():
+    assert PAPER_B.replace(length=0.1).geometry.length == 0.1
+    with pytest.raises(DesignError, match="outer_radius"):
+        PAPER_B.replace(outer_radius=0.01)
+
+
+# --- effects -----------------------------------------------------------------------------
+
+
+def test_effects_round_trip():
+    effects = {"inertia": {"mass": 1.5}, "nonuniform_strain": {}, "wave_effects": {"density": 1100}}
+    design = PAPER_B.replace(effects=effects)
+    assert design.effect_parameters == {
+        "inertia": {"mass": 1.5},
+        "nonuniform_strain": {},
+        "wave_effects": {"density": 1100.0},
+    }
+    assert loads_design(dumps_design(design)) == design
+
+
+@pytest.mark.parametrize(
+    "effects,key",
+    [
+        ({"magnetism": {}}, "effects.magnetism"),
+        ({"friction": {"friction_stress_max": 1e4}}, "effects.friction"),
+        ({"inertia": {}}, "effects.inertia.mass"),
+        ({"inertia": {"mass": -1}}, "effects.inertia.mass"),
+        ({"inertia": {"mass": "heavy"}}, "effects.inertia.mass"),
+        ({"viscous": {"viscosity": 1, "extra": 2}}, "effects.viscous.extra"),
+        ({"viscous": 3}, "effects.viscous"),
+        ([], "effects"),
+    ],
+)
+def test_bad_effects_refused(effects, key):
+    err = _refusal(lambda d: d.__setitem__("effects", effects))
+    assert err.key == key

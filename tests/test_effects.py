@@ -1,0 +1,136 @@
+"""Model extensions (MODEL.md's table of effects) against independent routes."""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+from scipy.integrate import solve_bvp
+
+from core import PAPER_B, TABLE_1, force_history, loop, shape_factor, stiffness, strain_factor
+from core.effects import EFFECTS, wave_stiffness
+from core.material import equivalent_modulus, equivalent_modulus_time_domain
+
+
+def test_library_covers_model_md_table():
+    assert set(EFFECTS) == {
+        "friction", "fractional", "inertia", "viscous", "strain_stiffening",
+        "rate_amplitude_coupling", "nonuniform_strain", "wave_effects",
+    }
+    for e in EFFECTS.values():
+        assert e.title and len(e.physics) > 40 and len(e.signature) > 40
+
+
+@pytest.mark.parametrize(
+    "effects",
+    [
+        {"viscous": {"viscosity": 800.0}},
+        {"strain_stiffening": {"stiffening": 40.0}},
+        {"rate_amplitude_coupling": {"rate_exponent": 0.3}},
+        {"viscous": {"viscosity": 300.0}, "strain_stiffening": {"stiffening": 10.0}},
+    ],
+)
+def test_material_effects_simulated_in_time_domain_match_analytic(effects):
+    design = TABLE_1.replace(effects=effects)
+    c = strain_factor(design.geometry, "torsion")
+    for f, phi in [(3.0, 0.02), (80.0, 0.15), (30.0, 1e-4)]:
+        td = equivalent_modulus_time_domain(design.material, f, c * phi, effects=effects).modulus
+        k = stiffness(design, f, phi).stiffness[0, 0]
+        assert_allclose(shape_factor(design.geometry, "torsion") * td, k, rtol=1e-4)
+
+
+def test_material_effects_change_what_they_should():
+    base = stiffness(PAPER_B, [1.0, 100.0], [1e-4, 1e-3]).stiffness
+    visc = stiffness(PAPER_B.replace(effects={"viscous": {"viscosity": 1e3}}), [1.0, 100.0], [1e-4, 1e-3]).stiffness
+    assert_allclose(visc.real, base.real)
+    assert_allclose((visc - base).imag[:, 1] / (visc - base).imag[:, 0], 100.0)  # ∝ ω
+    rate = stiffness(PAPER_B.replace(effects={"rate_amplitude_coupling": {"rate_exponent": 0.0}}), [1.0, 100.0], [1e-4, 1e-3]).stiffness
+    assert_allclose(rate, base, rtol=1e-14)  # γ = 0 is the separable model
+
+
+def test_inertia_is_minus_omega_squared_mass():
+    f = np.array([1.0, 50.0, 200.0])
+    base = stiffness(PAPER_B, f, 1e-4).stiffness
+    heavy = stiffness(PAPER_B.replace(effects={"inertia": {"mass": 3.0}}), f, 1e-4).stiffness
+    assert_allclose((heavy - base)[0], -((2 * np.pi * f) ** 2) * 3.0 + 0j, rtol=1e-9)
+
+
+def test_inertia_in_a_history_is_mass_times_acceleration():
+    f, n_p = 20.0, 4000
+    dt = 1 / (f * n_p)
+    t = dt * np.arange(n_p * 3)
+    x = 1e-4 * np.sin(2 * np.pi * f * t) ** 3
+    plain = force_history(PAPER_B, x, dt)
+    heavy = force_history(PAPER_B.replace(effects={"inertia": {"mass": 2.0}}), x, dt)
+    acc = 1e-4 * (2 * np.pi * f) ** 2 * (6 * np.sin(2 * np.pi * f * t) * np.cos(2 * np.pi * f * t) ** 2 - 3 * np.sin(2 * np.pi * f * t) ** 3)
+    assert_allclose((heavy.force - plain.force)[2:], 2.0 * acc[1:-1], atol=1e-3 * np.abs(2.0 * acc).max())
+
+
+def test_nonuniform_strain_is_the_continuum():
+    design = TABLE_1.replace(effects={"nonuniform_strain": {}})
+    r = stiffness(design, [10.0, 100.0], [1e-4, 1e-2])
+    assert r.slices == "continuum"
+    assert_allclose(r.stiffness, stiffness(TABLE_1, [10.0, 100.0], [1e-4, 1e-2], slices="continuum").stiffness)
+
+
+@pytest.mark.parametrize("design", [PAPER_B, TABLE_1])
+def test_wave_stiffness_tends_to_eqs_17_18(design):
+    mu = equivalent_modulus(design.material, 10.0, 1e-4)
+    g = design.geometry
+    k = wave_stiffness(design.mode, g.inner_radius, g.outer_radius, g.length, mu, 10.0, 1e-6)
+    assert_allclose(k, shape_factor(g, design.mode) * mu, rtol=1e-9)
+
+
+def _bvp_stiffness(mode, a, b, L, mu, f, rho):
+    """Shear waves by collocation (scipy solve_bvp), real and imaginary parts as four states."""
+    k2 = rho * (2 * np.pi * f) ** 2 / mu
+    n = 0 if mode == "axial" else 1
+
+    def rhs(r, y):
+        u = y[0] + 1j * y[1]
+        du = y[2] + 1j * y[3]
+        d2u = -du / r + (n * n / r**2 - k2) * u
+        return np.vstack([y[2], y[3], d2u.real, d2u.imag])
+
+    end = 1.0 if mode == "axial" else b  # w(b) = d = 1, or v(b) = b φ with φ = 1
+    bc = lambda ya, yb: np.array([ya[0], ya[1], yb[0] - end, yb[1]])
+    r = np.linspace(a, b, 400)
+    sol = solve_bvp(rhs, bc, r, np.vstack([(r - a) / (b - a) * end, 0 * r, 0 * r + end / (b - a), 0 * r]), tol=1e-10, max_nodes=100000)
+    assert sol.success
+    du_a = sol.sol(a)[2] + 1j * sol.sol(a)[3]
+    return 2 * np.pi * a ** (n + 1) * L * mu * du_a
+
+
+@pytest.mark.parametrize("design,f", [(PAPER_B, 400.0), (PAPER_B, 1500.0), (TABLE_1, 3000.0)])
+def test_wave_stiffness_equals_numerical_boundary_value_solution(design, f):
+    g = design.geometry
+    mu = equivalent_modulus(design.material, f, 1e-4)
+    exact = wave_stiffness(design.mode, g.inner_radius, g.outer_radius, g.length, mu, f, 1100.0)
+    numeric = _bvp_stiffness(design.mode, g.inner_radius, g.outer_radius, g.length, mu, f, 1100.0)
+    assert_allclose(exact, numeric, rtol=1e-6)
+    assert abs(exact / (shape_factor(g, design.mode) * mu) - 1) > 1e-3  # waves do matter here
+
+
+def test_wave_effects_through_stiffness():
+    design = PAPER_B.replace(effects={"wave_effects": {"density": 1100.0}})
+    f = np.array([1.0, 100.0, 800.0])
+    r = stiffness(design, f, 1e-4)
+    plain = stiffness(PAPER_B, f, 1e-4)
+    assert abs(r.stiffness[0, 0] / plain.stiffness[0, 0] - 1) < 1e-5
+    assert r.magnitude[0, 2] > plain.magnitude[0, 2]  # towards the first resonance
+
+
+def test_combinations_without_meaning_are_refused_with_a_message():
+    waves = PAPER_B.replace(effects={"wave_effects": {"density": 1100.0}})
+    with pytest.raises(ValueError, match="wave_effects"):
+        stiffness(waves, 10.0, 1e-4, slices=3)
+    with pytest.raises(ValueError, match="effects.inertia"):
+        loop(PAPER_B.replace(effects={"inertia": {"mass": 1.0}}), 10.0, 1e-4)
+    with pytest.raises(ValueError, match="rate_amplitude_coupling"):
+        force_history(PAPER_B.replace(effects={"rate_amplitude_coupling": {"rate_exponent": 0.2}}), [0, 1e-4], 1e-3)
+
+
+def test_loop_with_material_effects_matches_its_stiffness():
+    design = PAPER_B.replace(effects={"viscous": {"viscosity": 500.0}, "strain_stiffening": {"stiffening": 20.0}, "rate_amplitude_coupling": {"rate_exponent": 0.2}})
+    f, x = 30.0, 2e-3
+    lp = loop(design, f, x, 1024)
+    c = 2 * np.mean(lp.force * np.sin(lp.phase)) + 2j * np.mean(lp.force * np.cos(lp.phase))
+    assert_allclose(c / x, stiffness(design, f, x).stiffness[0, 0], rtol=1e-9)
