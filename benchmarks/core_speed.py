@@ -15,8 +15,7 @@ import time
 
 import numpy as np
 
-from core import PAPER_B, force_history, stiffness, strain_factor
-from core import bushing, slices
+from core import PAPER_B, bushing, force_history, slices, stiffness, strain_factor
 from core.material import equivalent_modulus, equivalent_modulus_time_domain, fractional_stress
 
 
@@ -83,7 +82,7 @@ def main():
         ("100×100 map, 3 slices", 3, "≤ 50 ms", 3),
         ("100×100 map, continuum", "continuum", "≤ 200 ms", slices.continuum_node_count(PAPER_B.geometry, "axial")),
     ):
-        seconds = timed(lambda: uncached_map(arg, f, x), 7)
+        seconds = timed(lambda arg=arg: uncached_map(arg, f, x), 7)
         evals = modulus_evaluations_per_point(arg, f, x)  # layer-evaluations per point
         row(name, seconds, target, td_point * f.size * x.size * evals)
         print(f"{'':<40} ({nodes} layers, {evals / nodes:.0f} modulus evaluations per layer)")
@@ -107,7 +106,7 @@ def main():
                        fractional_stress(eps, dt, PAPER_B.material.fractional_coefficient, PAPER_B.material.fractional_order))
     direct_est = w_direct * (n / m) ** 2
     for name, signal in (("10⁶-sample history, smooth drive", smooth), ("10⁶-sample history, noisy drive", noisy)):
-        seconds = timed(lambda: force_history(PAPER_B, signal, dt), 3)
+        seconds = timed(lambda signal=signal: force_history(PAPER_B, signal, dt), 3)
         reversals = int(np.count_nonzero(np.diff(np.sign(np.diff(signal)))))
         print(f"{name:<40} {seconds * 1e3:>9.0f} ms {'≤ 3 s':>10} {direct_est:>16.0f} s {direct_est / seconds:>10.0f}"
               f"   ({reversals} reversals)")

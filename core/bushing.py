@@ -22,9 +22,9 @@ from typing import Literal
 import numpy as np
 
 from . import material as mat
-from .material import REFERENCE_FREQUENCY_HZ
 from .design import Design, Geometry
 from .effects import extended_modulus, inertia_correction, wave_stiffness
+from .material import REFERENCE_FREQUENCY_HZ
 from .slices import continuum_nodes, slice_nodes, solve_series
 
 UNITS = {

@@ -187,7 +187,7 @@ def _one_line_errors():
         _fail(f"bushing: {exc}", 1)
     except KeyboardInterrupt:
         _fail("bushing: interrupted", 130)
-    except Exception as exc:  # the last guard: still one line, never a traceback
+    except Exception as exc:  # noqa: BLE001 - the last guard: one line, never a traceback
         _fail(f"bushing: internal error ({type(exc).__name__}: {exc})", 1)
 
 

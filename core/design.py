@@ -23,9 +23,10 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 MODES = ("axial", "torsion")
 
@@ -140,7 +141,7 @@ class Design:
     def effect_parameters(self) -> dict[str, dict[str, float]]:
         return {eid: dict(params) for eid, params in self.effects}
 
-    def replace(self, **changes) -> "Design":
+    def replace(self, **changes) -> Design:
         """A copy with top-level fields, or geometry/material fields by their own names, changed."""
         geo = {k: changes.pop(k) for k in list(changes) if k in _GEOMETRY_KEYS}
         mat = {k: changes.pop(k) for k in list(changes) if k in _MATERIAL_KEYS}

@@ -16,8 +16,9 @@ leaves in measured stiffness. How an effect enters the model is in one of three 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 from scipy import special

@@ -14,8 +14,8 @@ amplitudes follow ε(t) = Im(ε̂ e^{iωt}), so Im µ_eq ≥ 0 means dissipation
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Mapping
 
 import numpy as np
 from scipy.signal import oaconvolve
@@ -267,6 +267,18 @@ def _first_harmonic(signal, theta, weight_shift=0.0):
     return a + 1j * b
 
 
+def _period_modulus(br: BranchStresses, theta, n_p: int, k: int, shift: float, strain_amplitude):
+    """µ_eq from the first harmonic of the k-th last period of the branch stresses."""
+    sl = slice(theta.size - k * n_p, theta.size - (k - 1) * n_p)
+    th = theta[sl]
+    stress_amp = (
+        _first_harmonic(br.elastic[sl], th)
+        + _first_harmonic(br.fractional[sl], th, shift)  # GL: 2nd order at t − αΔt/2
+        + _first_harmonic(br.friction[sl], th)
+    )
+    return stress_amp / (2.0 * strain_amplitude)
+
+
 def samples_per_period_for(material: Material, strain_amplitude: float) -> int:
     """Samples per period resolving the friction knee (width ~ sqrt(2 ε½/ε̂) in phase)."""
     z = strain_amplitude / material.friction_strain_half
@@ -307,18 +319,9 @@ def equivalent_modulus_time_domain(
         theta = 2.0 * np.pi * np.arange(1, n + 1) / n_p
         strain = strain_amplitude * np.sin(theta)
         br = branch_stresses(material, strain, dt, effects, frequency_hz)
-
-        def modulus(k):  # k-th last period
-            sl = slice(n - k * n_p, n - (k - 1) * n_p)
-            th = theta[sl]
-            stress_amp = (
-                _first_harmonic(br.elastic[sl], th)
-                + _first_harmonic(br.fractional[sl], th, shift)
-                + _first_harmonic(br.friction[sl], th)
-            )
-            return stress_amp / (2.0 * strain_amplitude)
-
-        h1, h2, h3 = modulus(1), modulus(2), modulus(3)
+        h1, h2, h3 = (
+            _period_modulus(br, theta, n_p, k, shift, strain_amplitude) for k in (1, 2, 3)
+        )
         change = _remaining_change(h1, h2, h3)
         if change <= rtol:
             return TimeDomainModulus(complex(h1), total, n_p, float(change))

@@ -21,6 +21,7 @@ p = 1/(2π r² L), q = w / (2π r³ L) (torsion) and p = 1/(2π r L), q = w / (2
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import pairwise
 
 import numpy as np
 
@@ -42,7 +43,7 @@ def slice_nodes(geometry: Geometry, mode: str, n: int) -> SeriesNodes:
 
     r = np.linspace(geometry.inner_radius, geometry.outer_radius, n + 1)
     p, q = [], []
-    for r0, r1 in zip(r[:-1], r[1:]):
+    for r0, r1 in pairwise(r):
         g = Geometry(float(r0), float(r1), geometry.length)
         s = shape_factor(g, mode)
         p.append(2.0 * strain_factor(g, mode) / s)

@@ -1,5 +1,7 @@
 """Bushing stiffness, slices and continuum, loops and histories, against independent routes."""
 
+from itertools import pairwise
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -219,7 +221,7 @@ def test_slices_converge_monotonically_to_the_continuum(design):
     f = [1.0, 10.0, 100.0]
     k_inf = stiffness(design, f, x, slices="continuum").stiffness
     errors = [np.abs(stiffness(design, f, x, slices=n).stiffness / k_inf - 1) for n in (1, 2, 3, 5, 10, 20, 40)]
-    for coarse, fine in zip(errors, errors[1:]):
+    for coarse, fine in pairwise(errors):
         assert np.all(fine < coarse)
     # second order in 1/N: Richardson extrapolation of N = 20 and 40 lands on the continuum
     k20 = stiffness(design, f, x, slices=20).stiffness

@@ -60,7 +60,7 @@ def test_stiffness_log_grid_slices_and_file(designs, capsys, tmp_path):
         capsys,
     )
     assert status == 0 and out == ""
-    header, data = read_csv(out_path.read_text())
+    _, data = read_csv(out_path.read_text())
     assert_allclose(data[:, 0], [10, 100, 1000])
     ref = stiffness(TABLE_1, [10, 100, 1000], 1e-3, slices=3)
     assert_allclose(data[:, 4], ref.magnitude.ravel(), rtol=1e-11)
@@ -144,11 +144,11 @@ def test_installed_entry_point_runs_without_traceback(designs, tmp_path):
     """The console script as a user types it, in a separate process."""
     ok = subprocess.run(
         [sys.executable, "-m", "core.cli", "stiffness", str(designs["axial"]), "--freq", "1", "10", "2", "--amp", "1e-4"],
-        capture_output=True, text=True,
+        capture_output=True, text=True, check=False,
     )
     assert ok.returncode == 0 and ok.stdout.splitlines()[0] == ",".join(STIFFNESS_COLUMNS)
     bad = subprocess.run(
         [sys.executable, "-m", "core.cli", "loop", str(tmp_path / "none.json"), "--freq", "1", "--amp", "1e-3"],
-        capture_output=True, text=True,
+        capture_output=True, text=True, check=False,
     )
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "Traceback" not in bad.stderr
