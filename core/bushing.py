@@ -238,6 +238,34 @@ def stiffness(
     return _stiffness_cached(design, tuple(f.tolist()), tuple(x.tolist()), slices, route)
 
 
+def branch_stiffness(design: Design, frequency_hz, amplitude) -> dict[str, np.ndarray]:
+    """K split by branch (single equivalent modulus, eqs 16–18), each on the amplitude ×
+    frequency grid: ``elastic`` S·µ (with ``strain_stiffening``), ``viscoelastic``
+    S·(m(iω)^α/2 + iωc/2) (with ``viscous``), ``friction`` S·µ_f(ε̂) (with
+    ``rate_amplitude_coupling``). Their sum is :func:`stiffness` for a design without
+    stiffness-level effects (inertia, waves, non-uniform strain), which are refused here.
+    """
+    _refuse_structural_effects(design, "the branch-by-branch stiffness")
+    f = _grid("frequency_hz", frequency_hz)[None, :]
+    x = _grid("amplitude", amplitude)[:, None]
+    m = design.material
+    effects = design.effect_parameters
+    s = shape_factor(design.geometry, design.mode)
+    eps = strain_factor(design.geometry, design.mode) * x
+    zeros = np.zeros(np.broadcast_shapes(f.shape, x.shape))
+    elastic = s * m.shear_modulus * (
+        1.0 + 0.75 * effects.get("strain_stiffening", {}).get("stiffening", 0.0) * eps**2
+    ) + zeros
+    visco = s * (
+        mat.fractional_modulus(f, m.fractional_coefficient, m.fractional_order)
+        + 1j * np.pi * f * effects.get("viscous", {}).get("viscosity", 0.0)
+    ) + zeros
+    friction = s * mat.friction_modulus(eps, m.friction_stress_max, m.friction_strain_half) * (
+        f / REFERENCE_FREQUENCY_HZ
+    ) ** effects.get("rate_amplitude_coupling", {}).get("rate_exponent", 0.0) + zeros
+    return {"elastic": elastic + 0j, "viscoelastic": visco, "friction": friction + 0j}
+
+
 def cache_info():
     """Hits and misses of the stiffness cache (a functools.lru_cache, bounded)."""
     return _stiffness_cached.cache_info()

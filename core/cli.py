@@ -124,6 +124,16 @@ def build_parser() -> argparse.ArgumentParser:
         "--points", type=_count("--points", 4), default=256, metavar="N", help="default 256"
     )
     lp.add_argument("-o", dest="output", metavar="OUT.csv", help="write here, not to stdout")
+    sv = sub.add_parser(
+        "serve",
+        help="start the explorer in the browser (embedded defaults, no setup)",
+        description="Start the Bushing Explorer web app and print its URL.",
+    )
+    sv.add_argument("--port", type=_count("--port", 0), default=5006, metavar="P", help="default 5006")
+    sv.add_argument(
+        "--address", default="localhost", metavar="A",
+        help="interface to listen on (default localhost; 0.0.0.0 for every interface)",
+    )
     return parser
 
 
@@ -196,7 +206,18 @@ def _fail(message: str, status: int):
     raise SystemExit(status)
 
 
-COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop}
+def _cmd_serve(args) -> None:
+    if args.port > 65535:
+        raise InputError(f"bushing serve: --port must be at most 65535, got {args.port}")
+    from app.main import serve  # the browser app: imported only when asked for
+
+    try:
+        serve(port=args.port, address=args.address)
+    except OSError as exc:
+        raise InputError(f"bushing serve: cannot listen on {args.address}:{args.port}: {exc.strerror}")
+
+
+COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop, "serve": _cmd_serve}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -329,3 +329,15 @@ def test_force_history_refuses_bad_input(bad):
 def test_loop_refuses_bad_points():
     with pytest.raises(ValueError, match="points"):
         loop(PAPER_B, 1.0, 1e-3, 2)
+
+
+def test_branches_add_up_to_the_stiffness():
+    from core.bushing import branch_stiffness
+
+    for design in (PAPER_B, TABLE_1.replace(effects={"viscous": {"viscosity": 200.0}, "strain_stiffening": {"stiffening": 30.0}, "rate_amplitude_coupling": {"rate_exponent": 0.2}})):
+        f, x = [1.0, 30.0, 100.0], [1e-5, 1e-3, 0.1]
+        parts = branch_stiffness(design, f, x)
+        assert_allclose(sum(parts.values()), stiffness(design, f, x).stiffness, rtol=1e-13)
+        assert np.all(parts["elastic"].imag == 0)
+    with pytest.raises(ValueError, match="inertia"):
+        branch_stiffness(PAPER_B.replace(effects={"inertia": {"mass": 1.0}}), 1.0, 1e-4)

@@ -1,0 +1,118 @@
+"""The Bushing Explorer application: a factory that builds one session, and the server."""
+
+from __future__ import annotations
+
+import logging
+import os
+import sys
+
+import holoviews as hv
+import panel as pn
+
+from .state import ExplorerState
+from .views import (
+    URL_NAMES,
+    CompareView,
+    DesignInputs,
+    ExplorerPlots,
+    ExportView,
+    SlicesView,
+    TeachingView,
+    status_banner,
+)
+
+hv.extension("bokeh", logo=False)
+pn.extension(throttled=False)
+
+TITLE = "Bushing Explorer"
+
+ABOUT = """
+### Bushing Explorer
+
+Dynamic stiffness of carbon-black-filled rubber bushings, axially and in torsion, over frequency
+and amplitude, with the Fletcher–Gent (Payne) effect: the engineering formulas of M.-J. García
+Tárrago (KTH, 2006). Set the geometry and the five material parameters on the left, pick the
+operating point (drive amplitude and loop frequency), and read the loop, the stiffness magnitude
+|K| and the loss factor. **Tap** any frequency or amplitude plot to move the operating point
+there; every plot follows. All numbers come from the closed-form steady state, which the tests
+check against the thesis' time-domain simulation.
+
+**Units.** Radii and length in mm; µ and m in MPa (m in MPa·s^α); σ_fmax in kPa; ε½ and α
+plain numbers; the drive in mm (axial) or rad (torsion), as peak values. |K| in kN/mm (= MN/m)
+axially and N·m/rad in torsion. Files and the command line use SI.
+"""
+
+
+class App(pn.viewable.Viewer):
+    """One session of the explorer: its own state, inputs, plots and URL."""
+
+    def __init__(self, state: ExplorerState | None = None, **params):
+        super().__init__(**params)
+        self.state = state or ExplorerState()
+        self.inputs = DesignInputs(self.state)
+        self.plots = ExplorerPlots(self.state)
+        self.slices = SlicesView(self.state)
+        self.teaching = TeachingView(self.state)
+        self.compare = CompareView(self.state)
+        self.export = ExportView(self.state)
+        self.tabs = pn.Tabs(
+            ("Explorer", pn.Column(self.compare, self.plots, sizing_mode="stretch_width")),
+            ("Slices", self.slices),
+            ("Fletcher–Gent, branch by branch", self.teaching),
+            ("About", pn.pane.Markdown(ABOUT, sizing_mode="stretch_width")),
+            dynamic=True,
+            sizing_mode="stretch_width",
+        )
+
+    def sync_url(self):
+        """Put the whole design in the URL, and read one from it (a shared link)."""
+        if pn.state.location is not None:
+            pn.state.location.sync(self.state, URL_NAMES, on_error=self.state.apply_url_values)
+
+    def template(self):
+        template = pn.template.BootstrapTemplate(
+            title=TITLE,
+            sidebar=[self.inputs, pn.Card(self.export, title="Export and share", sizing_mode="stretch_width")],
+            main=[status_banner(self.state), self.tabs],
+            sidebar_width=380,
+            header_background="#1f5f8b",
+        )
+        return template
+
+    def __panel__(self):
+        return pn.Row(pn.Column(self.inputs, self.export, width=360), pn.Column(status_banner(self.state), self.tabs))
+
+
+def create_app():
+    """Factory for one session (served per connection, so sessions never share state)."""
+    app = App()
+    app.sync_url()
+    return app.template()
+
+
+def _origins(address: str, port: int) -> list[str]:
+    extra = [o for o in os.environ.get("BUSHING_ALLOWED_ORIGINS", "").split(",") if o]
+    if address in ("0.0.0.0", "::", ""):
+        return extra or ["*"]  # bound to every interface: reached by any host name
+    return [f"localhost:{port}", f"127.0.0.1:{port}", f"{address}:{port}", *extra]
+
+
+def serve(port: int = 5006, address: str = "localhost", show: bool = False):
+    """Start the explorer (blocking); prints the URL."""
+    logging.basicConfig(level=logging.WARNING, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    server = pn.serve(
+        create_app,
+        port=port,
+        address=address,
+        websocket_origin=_origins(address, port),
+        show=show,
+        start=False,
+        title=TITLE,
+        liveness=True,
+        verbose=False,
+    )
+    host = "localhost" if address in ("0.0.0.0", "::", "") else address
+    print(f"Bushing Explorer: http://{host}:{server.port}/", flush=True)
+    sys.stdout.flush()
+    server.start()
+    server.io_loop.start()

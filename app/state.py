@@ -1,0 +1,366 @@
+"""The explorer's state: one parameterized design session, with no Panel import.
+
+Parameters are in the units engineers read (mm, MPa, kPa, Hz; the drive amplitude in mm axially
+and rad in torsion); :attr:`ExplorerState.design` is the last *valid* core design in SI, and
+:attr:`ExplorerState.errors` says, field by field, what is wrong with the current input. Plots
+draw from the data methods below, which ask the (cached) core; nothing here draws.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import param
+
+from core import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material
+from core.design import as_dict
+from core.bushing import branch_stiffness, loop, stiffness, strain_factor
+from core.material import ConvergenceError
+
+# display parameter → (design key, factor from display unit to SI)
+GEOMETRY_FIELDS = {
+    "inner_radius_mm": ("inner_radius", 1e-3),
+    "outer_radius_mm": ("outer_radius", 1e-3),
+    "length_mm": ("length", 1e-3),
+}
+MATERIAL_FIELDS = {
+    "shear_modulus_mpa": ("shear_modulus", 1e6),
+    "fractional_coefficient_mpa": ("fractional_coefficient", 1e6),
+    "fractional_order": ("fractional_order", 1.0),
+    "friction_stress_max_kpa": ("friction_stress_max", 1e3),
+    "friction_strain_half": ("friction_strain_half", 1.0),
+}
+DESIGN_FIELDS = {**GEOMETRY_FIELDS, **MATERIAL_FIELDS}
+# design-error key → the display parameter to show the message beside
+ERROR_FIELD = {
+    **{f"geometry.{key}": name for name, (key, _) in GEOMETRY_FIELDS.items()},
+    **{f"material.{key}": name for name, (key, _) in MATERIAL_FIELDS.items()},
+}
+
+PRESETS = {"Paper B bushing (axial)": PAPER_B, "Table 1 bushing (torsion)": TABLE_1}
+
+# the Fletcher–Gent range: equivalent strain from 1e-3 to 1e2 times ε½
+FG_RANGE = (1e-3, 1e2)
+AMPLITUDE_DISPLAY = {"axial": ("mm", 1e-3), "torsion": ("rad", 1.0)}
+STIFFNESS_DISPLAY = {"axial": ("kN/mm", 1e6), "torsion": ("N·m/rad", 1.0)}
+FORCE_DISPLAY = {"axial": ("N", 1.0), "torsion": ("N·m", 1.0)}
+FREQUENCY_BOUNDS = (0.01, 10_000.0)
+SLICES = (1, 2, 3, "continuum")
+
+
+def _display_values(design: Design) -> dict:
+    """The state parameters that show ``design``."""
+    values = {"mode": design.mode}
+    for name, (key, factor) in GEOMETRY_FIELDS.items():
+        values[name] = getattr(design.geometry, key) / factor
+    for name, (key, factor) in MATERIAL_FIELDS.items():
+        values[name] = getattr(design.material, key) / factor
+    return {k: float(f"{v:.12g}") if isinstance(v, float) else v for k, v in values.items()}
+
+
+def _number(doc, label, default, **kw):
+    return param.Number(default, allow_None=True, label=label, doc=doc, **kw)
+
+
+class ExplorerState(param.Parameterized):
+    """One user's design session: inputs, the operating point, the pinned reference."""
+
+    preset = param.Selector(
+        objects=list(PRESETS), default=None, allow_None=True, label="Preset",
+        doc="Load a bushing from the thesis: Paper B (axial) or Table 1 (torsion).",
+    )
+    mode = param.Selector(
+        objects=["axial", "torsion"], default="axial", label="Mode",
+        doc="Axial: outer sleeve moved along the axis. Torsion: outer sleeve turned about it.",
+    )
+    inner_radius_mm = _number("Radius of the inner (bonded) sleeve.", "Inner radius a (mm)", 20.0)
+    outer_radius_mm = _number("Radius of the outer (bonded) sleeve; larger than a.", "Outer radius b (mm)", 35.0)
+    length_mm = _number("Axial length of the rubber.", "Length L (mm)", 90.0)
+    shear_modulus_mpa = _number("Elastic shear modulus µ: the stiffness that stays at any rate and amplitude.", "Shear modulus µ (MPa)", 2.42)
+    fractional_coefficient_mpa = _number("Fractional coefficient m: size of the frequency dependence.", "Fractional coefficient m (MPa·s^α)", 0.6)
+    fractional_order = _number("Fractional order α in (0, 1]: how fast stiffness rises with frequency.", "Fractional order α (–)", 0.2)
+    friction_stress_max_kpa = _number("Largest friction stress σ_fmax: size of the amplitude dependence.", "Friction stress σ_fmax (kPa)", 19.2)
+    friction_strain_half = _number("Strain ε½ at which half of σ_fmax is built: where the softening happens.", "Friction strain ε½ (–)", 4.0e-3)
+
+    amplitude = param.Number(
+        0.1, bounds=(1e-12, None), label="Drive amplitude",
+        doc="Peak displacement (mm, axial) or peak angle (rad, torsion) of the operating point.",
+    )
+    frequency_hz = param.Number(
+        10.0, bounds=FREQUENCY_BOUNDS, label="Loop frequency",
+        doc="Frequency of the operating point: the hysteresis loop and the highlighted curves.",
+    )
+    freq_min = _number("Lowest frequency of the sweeps.", "Sweep from (Hz)", 1.0)
+    freq_max = _number("Highest frequency of the sweeps.", "Sweep to (Hz)", 100.0)
+
+    design = param.ClassSelector(class_=Design, default=PAPER_B, doc="The last valid design (SI).")
+    errors = param.Dict(default={}, doc="Input field → what is wrong with it.")
+    reference = param.ClassSelector(class_=Design, default=None, allow_None=True, doc="Pinned design.")
+
+    effects = param.Dict(default={}, doc="Model extensions carried by a loaded design.")
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        self.param.watch(self._keep_strain_on_mode_change, ["mode", "amplitude"])
+        self._validate()
+
+    # ---- inputs → design -------------------------------------------------------------------
+
+    @param.depends("preset", watch=True)
+    def _apply_preset(self):
+        if self.preset is None:
+            return
+        self.load_design(PRESETS[self.preset])
+
+    def _keep_strain_on_mode_change(self, *events):
+        """The amplitude changes unit with the mode: keep the same equivalent strain, unless the
+        amplitude was set together with the mode (a preset, a link)."""
+        names = {e.name for e in events}
+        if names != {"mode"}:
+            return
+        old, new = events[0].old, events[0].new
+        geometry = self.design.geometry
+        eps = strain_factor(geometry, old) * self.amplitude * AMPLITUDE_DISPLAY[old][1]
+        x = eps / strain_factor(geometry, new) / AMPLITUDE_DISPLAY[new][1]
+        self.amplitude = float(f"{x:.3g}")
+
+    @param.depends(*DESIGN_FIELDS, "mode", "effects", "freq_min", "freq_max", watch=True, on_init=False)
+    def _validate(self):
+        errors = {}
+        values = {}
+        for name, (key, factor) in DESIGN_FIELDS.items():
+            v = getattr(self, name)
+            if v is None or not isinstance(v, (int, float)) or not math.isfinite(v):
+                errors[name] = "Enter a number."
+                continue
+            values[key] = v * factor
+            try:  # the core's own rule for this field alone (cross-field rules below)
+                Material(**{**as_dict(self.design.material), key: values[key]}) if name in MATERIAL_FIELDS else None
+                if name in GEOMETRY_FIELDS and values[key] <= 0:
+                    Geometry(**{**as_dict(self.design.geometry), key: values[key]})
+            except DesignError as exc:
+                errors[name] = _plain(exc)
+        if not errors:
+            try:
+                geometry = Geometry(**{k: values[k] for k, _ in GEOMETRY_FIELDS.values()})
+                material = Material(**{k: values[k] for k, _ in MATERIAL_FIELDS.values()})
+                design = Design(self.mode, geometry, material, effects=self.effects)
+            except DesignError as exc:
+                errors[ERROR_FIELD.get(exc.key, "mode")] = _plain(exc)
+            else:
+                design = _match_preset(design)
+                if design != self.design:
+                    self.design = design
+        fmin, fmax = self.freq_min, self.freq_max
+        if fmin is None or not math.isfinite(fmin) or fmin <= 0:
+            errors["freq_min"] = "Enter a positive frequency."
+        elif fmax is None or not math.isfinite(fmax) or fmax <= fmin:
+            errors["freq_max"] = "Must be above the lowest frequency."
+        elif fmax > FREQUENCY_BOUNDS[1]:
+            errors["freq_max"] = f"At most {FREQUENCY_BOUNDS[1]:g} Hz."
+        self.errors = errors
+
+    def load_design(self, design: Design):
+        """Show ``design`` (a preset, a file, a fit), its operating amplitude mid-range."""
+        x_mid = self.fletcher_gent_amplitudes(design)[2]
+        self.param.update(
+            **_display_values(design),
+            effects=design.effect_parameters,
+            amplitude=float(f"{x_mid:.3g}"),
+        )
+
+    def apply_url_values(self, values: dict):
+        """Apply values from a shared link one by one, so one bad value spoils no other."""
+        for name, value in values.items():
+            try:
+                self.param.update({name: value})
+            except Exception:  # noqa: BLE001 - a bad link value: keep the default, say so
+                self.errors = {**self.errors, name: f"The link's value {value!r} was not usable."}
+
+    # ---- units and ranges ------------------------------------------------------------------
+
+    @property
+    def amplitude_unit(self) -> str:
+        return AMPLITUDE_DISPLAY[self.design.mode][0]
+
+    @property
+    def stiffness_unit(self) -> str:
+        return STIFFNESS_DISPLAY[self.design.mode][0]
+
+    @property
+    def force_unit(self) -> str:
+        return FORCE_DISPLAY[self.design.mode][0]
+
+    @staticmethod
+    def fletcher_gent_amplitudes(design: Design, n: int = 5) -> np.ndarray:
+        """Drive amplitudes (display units) spanning the Fletcher–Gent range, ε̂/ε½ = 1e-3 … 1e2,
+        at n log-spaced points."""
+        c = strain_factor(design.geometry, design.mode)
+        scale = AMPLITUDE_DISPLAY[design.mode][1]
+        z = np.geomspace(*FG_RANGE, n)
+        return z * design.material.friction_strain_half / c / scale
+
+    @property
+    def amplitude_bounds(self) -> tuple[float, float]:
+        x = self.fletcher_gent_amplitudes(self.design, 2)
+        return float(x[0]), float(x[1])
+
+    def _si_amplitude(self, x):
+        return np.asarray(x, dtype=float) * AMPLITUDE_DISPLAY[self.design.mode][1]
+
+    def _stiffness_display(self, k):
+        return k / STIFFNESS_DISPLAY[self.design.mode][1]
+
+    def frequency_grid(self, n: int = 120) -> np.ndarray:
+        fmin, fmax = self.freq_min, self.freq_max
+        if "freq_min" in self.errors or "freq_max" in self.errors:
+            fmin, fmax = 1.0, 100.0
+        return np.linspace(fmin, fmax, n)
+
+    def amplitude_grid(self, n: int = 120) -> np.ndarray:
+        return np.geomspace(*self.amplitude_bounds, n)
+
+    def sweep_amplitudes(self) -> np.ndarray:
+        """The amplitudes of the frequency sweeps: decades of ε̂/ε½ from 0.01 to 10."""
+        return self.fletcher_gent_amplitudes(self.design, 6)[1:5]
+
+    def sweep_frequencies(self) -> np.ndarray:
+        f = self.frequency_grid(2)
+        return np.array([f[0], math.sqrt(f[0] * f[1]), f[1]])
+
+    # ---- data for the plots (no drawing) ---------------------------------------------------
+
+    def frequency_sweep(self, design: Design | None = None, amplitudes=None) -> dict:
+        """|K| (display unit) and loss factor against frequency at several amplitudes."""
+        design = design or self.design
+        amplitudes = self.sweep_amplitudes() if amplitudes is None else np.atleast_1d(amplitudes)
+        f = self.frequency_grid()
+        r = stiffness(design, f, self._si_amplitude(amplitudes))
+        return {"frequency_hz": f, "amplitude": amplitudes,
+                "magnitude": self._stiffness_display(r.magnitude), "loss_factor": r.loss_factor}
+
+    def amplitude_sweep(self, design: Design | None = None, frequencies=None) -> dict:
+        """|K| (display unit) and loss factor against amplitude at several frequencies."""
+        design = design or self.design
+        frequencies = self.sweep_frequencies() if frequencies is None else np.atleast_1d(frequencies)
+        x = self.amplitude_grid()
+        r = stiffness(design, frequencies, self._si_amplitude(x))
+        return {"amplitude": x, "frequency_hz": frequencies,
+                "magnitude": self._stiffness_display(r.magnitude.T), "loss_factor": r.loss_factor.T}
+
+    def hysteresis_loop(self, design: Design | None = None, amplitude=None, points: int = 200):
+        """One steady period at the operating point (or ``amplitude``), display units."""
+        design = design or self.design
+        x = self.amplitude if amplitude is None else amplitude
+        lp = loop(design, self.frequency_hz, float(self._si_amplitude(x)), points)
+        scale = 1.0 / AMPLITUDE_DISPLAY[design.mode][1]
+        close = np.r_[np.arange(points), 0]  # close the loop for drawing
+        return {
+            "displacement": lp.displacement[close] * scale,
+            "force": lp.force[close],
+            "force_elastic": lp.force_elastic[close],
+            "force_viscoelastic": lp.force_viscoelastic[close],
+            "force_friction": lp.force_friction[close],
+        }
+
+    def slice_comparison(self, n: int = 60) -> dict:
+        """|K| and loss factor against amplitude at the operating frequency for 1, 2, 3 slices
+        and the continuum, with the differences from the single modulus in %."""
+        x = self.amplitude_grid(n)
+        out = {"amplitude": x, "magnitude": {}, "loss_factor": {}, "magnitude_diff_pct": {},
+               "loss_factor_diff_pct": {}}
+        for s in SLICES:
+            try:
+                r = stiffness(self.design, self.frequency_hz, self._si_amplitude(x), slices=s)
+            except ConvergenceError:
+                continue  # said in the view; never an unconverged number
+            out["magnitude"][s] = self._stiffness_display(r.magnitude[:, 0])
+            out["loss_factor"][s] = r.loss_factor[:, 0]
+        base_m, base_e = out["magnitude"][1], out["loss_factor"][1]
+        for s in SLICES[1:]:
+            if s in out["magnitude"]:
+                out["magnitude_diff_pct"][s] = 100 * (out["magnitude"][s] / base_m - 1)
+                out["loss_factor_diff_pct"][s] = 100 * (out["loss_factor"][s] / base_e - 1)
+        return out
+
+    def branch_breakdown(self, n: int = 80) -> dict:
+        """How the elastic, viscoelastic and friction branches make up K against amplitude at
+        the operating frequency: their shares of Re K and of the loss factor."""
+        x = self.amplitude_grid(n)
+        parts = {k: v[:, 0] for k, v in branch_stiffness(self.design, self.frequency_hz, self._si_amplitude(x)).items()}
+        total = sum(parts.values())
+        re = total.real
+        return {
+            "amplitude": x,
+            "magnitude": self._stiffness_display(np.abs(total)),
+            "loss_factor": total.imag / re,
+            "real": {k: self._stiffness_display(v.real) for k, v in parts.items()},
+            "loss": {k: v.imag / re for k, v in parts.items()},
+        }
+
+    def operating_point(self, design: Design | None = None) -> dict:
+        design = design or self.design
+        r = stiffness(design, self.frequency_hz, self._si_amplitude(self.amplitude))
+        return {"magnitude": float(self._stiffness_display(r.magnitude[0, 0])),
+                "loss_factor": float(r.loss_factor[0, 0])}
+
+    def comparison(self) -> dict | None:
+        """Current design against the pinned reference, in %, at the operating point and over
+        the sweeps (largest difference)."""
+        if self.reference is None:
+            return None
+        now, ref = self.operating_point(), self.operating_point(self.reference)
+        fs_now, fs_ref = self.frequency_sweep(amplitudes=self.amplitude), self.frequency_sweep(self.reference, self.amplitude)
+        as_now, as_ref = self.amplitude_sweep(frequencies=self.frequency_hz), self.amplitude_sweep(self.reference, self.frequency_hz)
+
+        def worst(a, b):
+            d = 100 * (a / b - 1)
+            return float(d.flat[np.argmax(np.abs(d))])
+
+        return {
+            "operating": {
+                "magnitude": (now["magnitude"], ref["magnitude"], 100 * (now["magnitude"] / ref["magnitude"] - 1)),
+                "loss_factor": (now["loss_factor"], ref["loss_factor"], 100 * (now["loss_factor"] / ref["loss_factor"] - 1)),
+            },
+            "largest_over_frequency": {k: worst(fs_now[k], fs_ref[k]) for k in ("magnitude", "loss_factor")},
+            "largest_over_amplitude": {k: worst(as_now[k], as_ref[k]) for k in ("magnitude", "loss_factor")},
+        }
+
+    def pin_reference(self):
+        self.reference = self.design
+
+    def clear_reference(self):
+        self.reference = None
+
+    # ---- export ------------------------------------------------------------------------------
+
+    def stiffness_table(self, n_freq: int = 25, n_amp: int = 25) -> dict:
+        """The FORMATS.md stiffness table over the sweeps' frequency range and the
+        Fletcher–Gent amplitude range (SI units)."""
+        r = stiffness(self.design, self.frequency_grid(n_freq), self._si_amplitude(self.amplitude_grid(n_amp)))
+        return r.table()
+
+
+def _match_preset(design: Design) -> Design:
+    """The preset itself (exact SI values, its name) when the inputs show a preset."""
+    shown = _display_values(design)
+    for preset in PRESETS.values():
+        if _display_values(preset) == shown and not design.effects:
+            return preset
+    return design
+
+
+def _plain(exc: DesignError) -> str:
+    """A design error in the words of the input panel (mm, MPa) rather than the file's keys."""
+    rule = exc.rule
+    for name, (key, _) in DESIGN_FIELDS.items():
+        rule = rule.replace(f"geometry.{key}", name).replace(f"material.{key}", name)
+    rule = rule.replace("outer_radius_mm", "b").replace("inner_radius_mm", "a")
+    if "b > a" in rule:
+        return "Must be larger than the inner radius a."
+    if "must be positive" in rule:
+        return "Must be positive."
+    if "(0, 1]" in rule:
+        return "Must lie in (0, 1]."
+    return rule[0].upper() + rule[1:]
