@@ -136,11 +136,17 @@ class ExplorerState(param.Parameterized):
                 continue
             values[key] = v * factor
             try:  # the core's own rule for this field alone (cross-field rules below)
-                Material(**{**as_dict(self.design.material), key: values[key]}) if name in MATERIAL_FIELDS else None
-                if name in GEOMETRY_FIELDS and values[key] <= 0:
+                if name in MATERIAL_FIELDS:
+                    Material(**{**as_dict(self.design.material), key: values[key]})
+                elif values[key] <= 0:
                     Geometry(**{**as_dict(self.design.geometry), key: values[key]})
             except DesignError as exc:
                 errors[name] = _plain(exc)
+        if "inner_radius_mm" not in errors and "outer_radius_mm" not in errors:
+            try:  # b > a, whatever else is wrong
+                Geometry(values["inner_radius"], values["outer_radius"], self.design.geometry.length)
+            except DesignError as exc:
+                errors["outer_radius_mm"] = _plain(exc)
         if not errors:
             try:
                 geometry = Geometry(**{k: values[k] for k, _ in GEOMETRY_FIELDS.values()})
@@ -172,11 +178,14 @@ class ExplorerState(param.Parameterized):
 
     def apply_url_values(self, values: dict):
         """Apply values from a shared link one by one, so one bad value spoils no other."""
+        unusable = {}
         for name, value in values.items():
             try:
                 self.param.update({name: value})
             except Exception:  # noqa: BLE001 - a bad link value: keep the default, say so
-                self.errors = {**self.errors, name: f"The link's value {value!r} was not usable."}
+                unusable[name] = f"The link's value {value!r} was not usable; kept {getattr(self, name)!r}."
+        if unusable:
+            self.errors = {**self.errors, **unusable}
 
     # ---- units and ranges ------------------------------------------------------------------
 

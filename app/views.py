@@ -16,7 +16,7 @@ import holoviews as hv
 import numpy as np
 import panel as pn
 import param
-from bokeh.models import CustomJSTickFormatter
+from bokeh.models import CustomJSTickFormatter, SaveTool
 from holoviews import streams
 
 from core.design import dumps_design
@@ -34,6 +34,17 @@ PLOT_OPTS = {
     "framewise": True,
     "show_grid": True,
 }
+
+
+def png_name(filename: str):
+    """A HoloViews hook that names the PNG of the plot's save tool (no filename prompt)."""
+
+    def hook(plot, _element):
+        for tool in plot.state.toolbar.tools:
+            if isinstance(tool, SaveTool):
+                tool.filename = filename
+
+    return hook
 
 
 def guarded(fn):
@@ -68,7 +79,7 @@ class LogSlider(pn.viewable.Viewer):
         p = state.param[name]
         lo, hi = bounds()
         self.slider = pn.widgets.FloatSlider(
-            name=self._label(),
+            label=self._label(),
             start=math.log10(lo),
             end=math.log10(hi),
             step=0.005,
@@ -104,7 +115,7 @@ class LogSlider(pn.viewable.Viewer):
     def _rescale(self, _event):
         lo, hi = self._bounds()
         self.slider.param.update(
-            start=math.log10(lo), end=math.log10(hi), name=self._label(),
+            start=math.log10(lo), end=math.log10(hi), label=self._label(),
             value=self._clip(math.log10(getattr(self._state, self._name))),
         )
 
@@ -133,21 +144,21 @@ class DesignInputs(pn.viewable.Viewer):
         self.widgets = {
             name: pn.widgets.FloatInput.from_param(
                 state.param[name], description=state.param[name].doc, step=steps.get(name, 0.5),
-                sizing_mode="stretch_width", name=state.param[name].label,
+                sizing_mode="stretch_width", label=state.param[name].label,
             )
             for name in DESIGN_FIELDS
         }
         for name in ("freq_min", "freq_max"):
             self.widgets[name] = pn.widgets.FloatInput.from_param(
                 state.param[name], description=state.param[name].doc, step=1.0,
-                sizing_mode="stretch_width", name=state.param[name].label,
+                sizing_mode="stretch_width", label=state.param[name].label,
             )
         self.preset = pn.widgets.Select.from_param(
             state.param.preset, description=state.param.preset.doc, sizing_mode="stretch_width",
         )
         self.mode = pn.widgets.RadioButtonGroup.from_param(
-            state.param.mode, description=state.param.mode.doc, button_type="primary",
-            button_style="outline", sizing_mode="stretch_width",
+            state.param.mode, description=state.param.mode.doc, color="primary",
+            variant="outline", sizing_mode="stretch_width",
         )
         self.amplitude = LogSlider(state, "amplitude", lambda: state.amplitude_bounds, lambda: state.amplitude_unit)
         self.frequency = LogSlider(state, "frequency_hz", lambda: (0.1, 1000.0), lambda: "Hz")
@@ -193,37 +204,38 @@ class ExplorerPlots(pn.viewable.Viewer):
             * hv.DynamicMap(pn.bind(self._loop_total, **design_deps, **op))
         ).opts(
             hv.opts.Curve(responsive=True, min_height=300, framewise=True, show_grid=True, tools=["hover"], line_width=1.5),
-            hv.opts.Overlay(legend_position="top_left"),
+            hv.opts.Overlay(legend_position="top_left", hooks=[png_name("bushing-hysteresis-loop")]),
         )
 
-        self.panels = {}
-        for quantity in ("magnitude", "loss_factor"):
-            for axis in ("frequency", "amplitude"):
-                self.panels[(quantity, axis)] = (
-                    hv.DynamicMap(pn.bind(self._sweep, quantity=quantity, axis=axis, **design_deps, **op))
-                    * hv.DynamicMap(pn.bind(self._reference_curve, quantity=quantity, axis=axis, **design_deps, **op, **ref))
-                    * hv.DynamicMap(pn.bind(self._operating_curve, quantity=quantity, axis=axis, **design_deps, **op))
-                    * hv.DynamicMap(pn.bind(self._marker, axis=axis, **op))
-                )
-        self.taps = []
-        for (quantity, axis), overlay in self.panels.items():
-            tap = streams.Tap(source=overlay, x=None, y=None)
-            tap.add_subscriber(functools.partial(self._on_tap, axis))
-            self.taps.append(tap)
-        opts = [
-            hv.opts.Curve(**PLOT_OPTS),
-            hv.opts.VLine(color=plots.OPERATING_COLOR, line_width=1.5, line_dash="dotted"),
-            hv.opts.NdOverlay(legend_position="right"),
-        ]
         titles = {
             ("magnitude", "frequency"): "|K| against frequency",
             ("loss_factor", "frequency"): "Loss factor against frequency",
             ("magnitude", "amplitude"): "|K| against amplitude",
             ("loss_factor", "amplitude"): "Loss factor against amplitude",
         }
-        for key, overlay in self.panels.items():
-            logx = key[1] == "amplitude"
-            self.panels[key] = overlay.opts(*opts, hv.opts.Curve(logx=logx), hv.opts.Overlay(title=titles[key], logx=logx))
+        self.panels, self.taps = {}, []
+        for quantity in ("magnitude", "loss_factor"):
+            for axis in ("frequency", "amplitude"):
+                logx = axis == "amplitude"
+                operating = hv.DynamicMap(
+                    pn.bind(self._operating_curve, quantity=quantity, axis=axis, **design_deps, **op)
+                ).opts(hv.opts.Curve(**PLOT_OPTS, logx=logx))
+                # a linked stream attaches to a map of single elements, not to an overlay
+                tap = streams.Tap(source=operating, x=None, y=None)
+                tap.add_subscriber(functools.partial(self._on_tap, axis))
+                self.taps.append(tap)
+                self.panels[(quantity, axis)] = (
+                    hv.DynamicMap(pn.bind(self._sweep, quantity=quantity, axis=axis, **design_deps, **op))
+                    * hv.DynamicMap(pn.bind(self._reference_curve, quantity=quantity, axis=axis, **design_deps, **op, **ref))
+                    * operating
+                    * hv.DynamicMap(pn.bind(self._marker, axis=axis, **op))
+                ).opts(
+                    hv.opts.Curve(**PLOT_OPTS, logx=logx),
+                    hv.opts.VLine(color=plots.OPERATING_COLOR, line_width=1.5, line_dash="dotted"),
+                    hv.opts.NdOverlay(legend_position="right"),
+                    hv.opts.Overlay(title=titles[(quantity, axis)], logx=logx,
+                                    hooks=[png_name(f"bushing-{quantity}-vs-{axis}")]),
+                )
 
     # data → elements (each callback one element type)
 
@@ -322,18 +334,21 @@ class SlicesView(pn.viewable.Viewer):
         self.state = state
         s = state.param
         deps = {"design": s.design, "f": s.frequency_hz, "errors": s.errors}
-        marker = hv.DynamicMap(pn.bind(lambda x: plots.marker(x), x=s.amplitude))
-        self.magnitude = (hv.DynamicMap(pn.bind(self._curves, which="magnitude", **deps)) * marker)
-        self.difference = (hv.DynamicMap(pn.bind(self._curves, which="magnitude_diff_pct", **deps)) * marker)
-        self.loss = (hv.DynamicMap(pn.bind(self._curves, which="loss_factor", **deps)) * marker)
         opts = [hv.opts.Curve(**PLOT_OPTS, logx=True), hv.opts.NdOverlay(legend_position="right"),
                 hv.opts.VLine(color=plots.OPERATING_COLOR, line_dash="dotted")]
-        self.magnitude = self.magnitude.opts(*opts, hv.opts.Overlay(title="|K|: single modulus, slices and continuum", logx=True))
-        self.difference = self.difference.opts(*opts, hv.opts.Overlay(title="|K| difference from the single modulus (%)", logx=True))
-        self.loss = self.loss.opts(*opts, hv.opts.Overlay(title="Loss factor", logx=True))
-        for overlay in (self.magnitude, self.difference, self.loss):
-            tap = streams.Tap(source=overlay, x=None, y=None)
-            tap.add_subscriber(self._on_tap)
+        titles = {
+            "magnitude": "|K|: single modulus, slices and continuum",
+            "magnitude_diff_pct": "|K| difference from the single modulus (%)",
+            "loss_factor": "Loss factor",
+        }
+        self.overlays = {}
+        for which, title in titles.items():
+            curves = hv.DynamicMap(pn.bind(self._curves, which=which, **deps)).opts(*opts)
+            marker = hv.DynamicMap(pn.bind(plots.marker, s.amplitude)).opts(*opts)
+            # a linked stream attaches to a map of single elements, not to an overlay
+            streams.Tap(source=marker, x=None, y=None).add_subscriber(self._on_tap)
+            self.overlays[which] = (curves * marker).opts(
+                *opts, hv.opts.Overlay(title=title, logx=True, hooks=[png_name(f"bushing-slices-{which}")]))
 
     @guarded
     def _curves(self, which, design, f, errors):
@@ -374,9 +389,9 @@ class SlicesView(pn.viewable.Viewer):
                 "equivalent modulus (eqs 17/18) is close when the differences below are small. "
                 "All at the loop frequency.", sizing_mode="stretch_width"),
             pn.pane.Markdown(pn.bind(self.summary, s.design, s.frequency_hz, s.amplitude), sizing_mode="stretch_width"),
-            pn.pane.HoloViews(self.magnitude, sizing_mode="stretch_width", height=300),
-            pn.pane.HoloViews(self.difference, sizing_mode="stretch_width", height=260),
-            pn.pane.HoloViews(self.loss, sizing_mode="stretch_width", height=260),
+            pn.pane.HoloViews(self.overlays["magnitude"], sizing_mode="stretch_width", height=300),
+            pn.pane.HoloViews(self.overlays["magnitude_diff_pct"], sizing_mode="stretch_width", height=260),
+            pn.pane.HoloViews(self.overlays["loss_factor"], sizing_mode="stretch_width", height=260),
             sizing_mode="stretch_width",
         )
 
@@ -391,7 +406,7 @@ class TeachingView(pn.viewable.Viewer):
         deps = {"design": s.design, "f": s.frequency_hz, "errors": s.errors}
         self.frames = 48
         self.player = pn.widgets.Player(
-            name="Amplitude sweep", start=0, end=self.frames - 1, value=self.frames // 2,
+            label="Amplitude sweep", start=0, end=self.frames - 1, value=self.frames // 2,
             loop_policy="loop", interval=150, show_value=False, show_loop_controls=False,
             sizing_mode="stretch_width",
         )
@@ -399,12 +414,15 @@ class TeachingView(pn.viewable.Viewer):
         opts = [hv.opts.Area(**{k: v for k, v in PLOT_OPTS.items() if k not in ("tools", "active_tools")}, logx=True, fill_alpha=0.55, line_width=1),
                 hv.opts.Overlay(legend_position="top_right"), hv.opts.VLine(color=plots.OPERATING_COLOR, line_dash="dotted")]
         self.real = (hv.DynamicMap(pn.bind(self._areas, which="real", **deps)) * marker).opts(
-            *opts, hv.opts.Overlay(title="Re K, branch by branch (stacked)", logx=True))
+            *opts, hv.opts.Overlay(title="Re K, branch by branch (stacked)", logx=True,
+                                   hooks=[png_name("bushing-branches-stiffness")]))
         self.loss = (hv.DynamicMap(pn.bind(self._areas, which="loss", **deps)) * marker).opts(
-            *opts, hv.opts.Overlay(title="Loss factor, branch by branch (stacked)", logx=True))
+            *opts, hv.opts.Overlay(title="Loss factor, branch by branch (stacked)", logx=True,
+                                   hooks=[png_name("bushing-branches-loss-factor")]))
         self.loop = hv.DynamicMap(pn.bind(self._loop_frame, frame=self.player.param.value, **deps)).opts(
             hv.opts.Curve(responsive=True, min_height=300, framewise=False, tools=["hover"]),
-            hv.opts.NdOverlay(legend_position="top_left", xlim=(-1.05, 1.05), ylim=(-1.1, 1.1)),
+            hv.opts.NdOverlay(legend_position="top_left", xlim=(-1.05, 1.05), ylim=(-1.1, 1.1),
+                              hooks=[png_name("bushing-loop-shape")]),
         )
 
     def _frame_amplitudes(self):
@@ -461,8 +479,8 @@ class CompareView(pn.viewable.Viewer):
     def __init__(self, state: ExplorerState, **params):
         super().__init__(**params)
         self.state = state
-        self.pin = pn.widgets.Button(name="Pin as reference", button_type="primary", description="Keep this design to compare the next ones with it (dashed curves).")
-        self.clear = pn.widgets.Button(name="Clear reference", button_type="light")
+        self.pin = pn.widgets.Button(label="Pin as reference", color="primary", description="Keep this design to compare the next ones with it (dashed curves).")
+        self.clear = pn.widgets.Button(label="Clear reference", color="light")
         self.pin.on_click(lambda _e: state.pin_reference())
         self.clear.on_click(lambda _e: state.clear_reference())
 
@@ -501,11 +519,11 @@ class ExportView(pn.viewable.Viewer):
         self.state = state
         self.design_file = pn.widgets.FileDownload(
             callback=self._design_json, filename="bushing-design.json", label="Design file (JSON)",
-            button_type="default", sizing_mode="stretch_width",
+            color="default", sizing_mode="stretch_width",
         )
         self.table_file = pn.widgets.FileDownload(
             callback=self._table_csv, filename="bushing-stiffness.csv", label="Stiffness table (CSV)",
-            button_type="default", sizing_mode="stretch_width",
+            color="default", sizing_mode="stretch_width",
         )
 
     def _design_json(self):

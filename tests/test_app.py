@@ -1,0 +1,219 @@
+"""The explorer without a browser: build a session, set parameters, check what the plots hold
+against the core."""
+
+import csv
+import io
+import logging
+
+import holoviews as hv
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from app.main import App, create_app
+from app.state import ExplorerState
+from core import PAPER_B, TABLE_1, loads_design, loop, stiffness
+
+
+@pytest.fixture
+def app():
+    return App()
+
+
+def curves(overlay):
+    """Every Curve in a (nested) overlay, by label."""
+    out = {}
+    for el in overlay.traverse(lambda e: e, [hv.Curve]):
+        out.setdefault(el.label, []).append(el)
+    return out
+
+
+def operating(app, quantity, axis):
+    overlay = app.plots.panels[(quantity, axis)][()]
+    label = next(lbl for lbl in curves(overlay) if lbl.startswith("at "))
+    return curves(overlay)[label][0]
+
+
+def test_factory_builds_a_fresh_session_each_time():
+    a, b = create_app(), create_app()
+    assert a is not b
+    s1, s2 = ExplorerState(), ExplorerState()
+    s1.shear_modulus_mpa = 3.0
+    assert s2.shear_modulus_mpa == 2.42  # sessions never share state
+
+
+def test_defaults_are_the_paper_b_bushing(app):
+    assert app.state.design == PAPER_B
+    assert app.state.errors == {}
+
+
+def test_frequency_plot_holds_the_core_stiffness(app):
+    s = app.state
+    c = operating(app, "magnitude", "frequency")
+    f = c.dimension_values("frequency_hz")
+    ref = stiffness(PAPER_B, f, s.amplitude * 1e-3)
+    assert_allclose(c.dimension_values("magnitude"), ref.magnitude[0] / 1e6, rtol=1e-12)
+    eta = operating(app, "loss_factor", "frequency")
+    assert_allclose(eta.dimension_values("loss_factor"), ref.loss_factor[0], rtol=1e-12)
+    assert c.kdims[0].unit == "Hz" and c.vdims[0].unit == "kN/mm"
+
+
+def test_amplitude_plot_holds_the_core_stiffness_in_torsion(app):
+    s = app.state
+    s.preset = "Table 1 bushing (torsion)"
+    assert s.design == TABLE_1
+    c = operating(app, "magnitude", "amplitude")
+    x = c.dimension_values("amplitude")
+    ref = stiffness(TABLE_1, s.frequency_hz, x)
+    assert_allclose(c.dimension_values("magnitude"), ref.magnitude[:, 0], rtol=1e-12)
+    assert c.kdims[0].unit == "rad" and c.vdims[0].unit == "N·m/rad"
+    # the amplitude axis spans the Fletcher–Gent range: ε̂/ε½ from 1e-3 to 1e2
+    from core import strain_factor
+
+    z = strain_factor(TABLE_1.geometry, "torsion") * x / TABLE_1.material.friction_strain_half
+    assert_allclose([z.min(), z.max()], [1e-3, 1e2], rtol=1e-9)
+
+
+def test_loop_holds_the_core_loop_and_its_branches(app):
+    s = app.state
+    s.amplitude, s.frequency_hz = 0.5, 3.0
+    overlay = app.plots.loop[()]
+    total = [c for c in overlay.traverse(lambda e: e, [hv.Curve]) if c.label == "total"][0]
+    ref = loop(PAPER_B, 3.0, 0.5e-3, 200)
+    assert_allclose(total.dimension_values("displacement")[:-1], ref.displacement * 1e3, atol=1e-12)
+    assert_allclose(total.dimension_values("force")[:-1], ref.force, rtol=1e-12, atol=1e-9)
+    assert total.dimension_values("force")[0] == total.dimension_values("force")[-1]  # closed
+
+
+def test_moving_a_widget_changes_the_plots(app):
+    before = operating(app, "magnitude", "frequency").dimension_values("magnitude")
+    app.inputs.widgets["shear_modulus_mpa"].value = 3.0
+    after = operating(app, "magnitude", "frequency").dimension_values("magnitude")
+    assert app.state.design.material.shear_modulus == pytest.approx(3.0e6)
+    assert np.all(after > before)
+
+
+def test_log_slider_sets_the_amplitude_and_follows_it(app):
+    slider = app.inputs.amplitude.slider
+    slider.value = np.log10(0.5)
+    assert app.state.amplitude == pytest.approx(0.5, rel=1e-3)
+    app.state.amplitude = 2.0
+    assert slider.value == pytest.approx(np.log10(2.0))
+
+
+def test_tap_moves_the_operating_point_in_every_plot(app):
+    tap_f = app.plots.taps[0]  # (magnitude, frequency)
+    tap_f.event(x=42.0, y=4.0)
+    assert app.state.frequency_hz == pytest.approx(42.0)
+    for quantity in ("magnitude", "loss_factor"):
+        overlay = app.plots.panels[(quantity, "frequency")][()]
+        vline = overlay.traverse(lambda e: e, [hv.VLine])[0]
+        assert vline.data == pytest.approx(42.0)
+        assert any(lbl == "at 42 Hz" for lbl in curves(app.plots.panels[(quantity, "amplitude")][()]))
+    tap_a = next(t for t, key in zip(app.plots.taps, app.plots.panels) if key == ("loss_factor", "amplitude"))
+    tap_a.event(x=0.03, y=0.1)
+    assert app.state.amplitude == pytest.approx(0.03)
+    assert "0.03" in app.plots.loop[()].traverse(lambda e: e, [hv.Curve])[-1].opts.get().kwargs["title"]
+
+
+def test_invalid_input_keeps_the_last_good_design_and_says_why(app):
+    good = operating(app, "magnitude", "frequency").dimension_values("magnitude")
+    app.state.outer_radius_mm = 15.0  # below a = 20 mm
+    assert app.state.errors == {"outer_radius_mm": "Must be larger than the inner radius a."}
+    assert app.state.design == PAPER_B
+    assert_allclose(operating(app, "magnitude", "frequency").dimension_values("magnitude"), good)
+    app.state.fractional_order = 1.4
+    app.state.length_mm = None
+    assert set(app.state.errors) == {"outer_radius_mm", "fractional_order", "length_mm"}
+    app.state.param.update(outer_radius_mm=35.0, fractional_order=0.2, length_mm=90.0)
+    assert app.state.errors == {} and app.state.design == PAPER_B
+
+
+def test_sweep_range_errors(app):
+    app.state.freq_max = 0.5
+    assert "freq_max" in app.state.errors
+    f = operating(app, "magnitude", "frequency").dimension_values("frequency_hz")
+    assert f.min() > 0 and f.max() > f.min()
+
+
+def test_mode_change_keeps_the_equivalent_strain(app):
+    from core import strain_factor
+
+    s = app.state
+    s.amplitude = 0.2  # mm, axial
+    eps = strain_factor(s.design.geometry, "axial") * 0.2e-3
+    s.mode = "torsion"
+    assert s.design.mode == "torsion"
+    assert strain_factor(s.design.geometry, "torsion") * s.amplitude == pytest.approx(eps, rel=1e-2)
+
+
+def test_link_values_are_applied_one_by_one():
+    s = ExplorerState()
+    s.apply_url_values({"shear_modulus_mpa": 3.1, "amplitude": -1.0, "length_mm": 80.0})
+    assert s.shear_modulus_mpa == 3.1 and s.length_mm == 80.0
+    assert "amplitude" in s.errors
+
+
+def test_slices_view_holds_the_core_numbers(app):
+    data = app.state.slice_comparison()
+    x = data["amplitude"] * 1e-3
+    for sl in (1, 2, 3, "continuum"):
+        ref = stiffness(PAPER_B, app.state.frequency_hz, x, slices=sl)
+        assert_allclose(data["magnitude"][sl], ref.magnitude[:, 0] / 1e6, rtol=1e-12)
+    k1 = stiffness(PAPER_B, app.state.frequency_hz, x).magnitude[:, 0]
+    k3 = stiffness(PAPER_B, app.state.frequency_hz, x, slices=3).magnitude[:, 0]
+    assert_allclose(data["magnitude_diff_pct"][3], 100 * (k3 / k1 - 1), rtol=1e-9)
+    assert "3 slices" in app.slices.summary(app.state.design, 10.0, 0.1)
+
+
+def test_teaching_branches_add_up_to_the_stiffness(app):
+    d = app.state.branch_breakdown()
+    x = d["amplitude"] * 1e-3
+    ref = stiffness(PAPER_B, app.state.frequency_hz, x)
+    assert_allclose(sum(d["real"].values()), ref.stiffness.real[:, 0] / 1e6, rtol=1e-12)
+    assert_allclose(sum(d["loss"].values()), ref.loss_factor[:, 0], rtol=1e-12)
+    assert np.all(d["loss"]["elastic"] == 0)
+    frame = app.teaching._loop_frame(5, app.state.design, 10.0, {})
+    assert set(frame.keys()) == {"total", "elastic", "viscoelastic", "friction"}
+
+
+def test_comparison_with_a_pinned_reference(app):
+    s = app.state
+    assert s.comparison() is None
+    s.pin_reference()
+    s.length_mm = 99.0  # stiffness ∝ L: +10 %
+    c = s.comparison()
+    assert c["operating"]["magnitude"][2] == pytest.approx(10.0, rel=1e-9)
+    assert c["operating"]["loss_factor"][2] == pytest.approx(0.0, abs=1e-9)
+    assert c["largest_over_frequency"]["magnitude"] == pytest.approx(10.0, rel=1e-9)
+    overlay = app.plots.panels[("magnitude", "frequency")][()]
+    ref = curves(overlay)["reference"][0]
+    assert_allclose(ref.dimension_values("magnitude") * 1.1, operating(app, "magnitude", "frequency").dimension_values("magnitude"), rtol=1e-12)
+    assert "+10.00 %" in app.compare.table(s.reference, s.design, s.frequency_hz, s.amplitude, s.errors)
+    s.clear_reference()
+    assert s.comparison() is None
+
+
+def test_exports_are_the_public_formats(app):
+    app.state.shear_modulus_mpa = 2.9
+    design = loads_design(app.export._design_json().getvalue())
+    assert design == app.state.design
+    rows = list(csv.reader(io.StringIO(app.export._table_csv().getvalue())))
+    assert rows[0] == ["frequency_hz", "amplitude", "stiffness_real", "stiffness_imag", "magnitude", "loss_factor"]
+    data = np.array(rows[1:], dtype=float)
+    ref = stiffness(app.state.design, data[:, 0], data[0, 1])
+    assert_allclose(data[data[:, 1] == data[0, 1], 4], ref.magnitude[0, data[:, 1] == data[0, 1]], rtol=1e-10)
+
+
+def test_plot_callbacks_keep_the_last_plot_and_log_one_line(app, caplog):
+    good = app.plots._operating_curve("magnitude", "frequency", app.state.design, 1, 100, {}, 10.0, 0.1)
+    original = app.state.frequency_sweep
+    app.state.frequency_sweep = lambda *a, **k: 1 / 0
+    try:
+        with caplog.at_level(logging.WARNING, logger="bushing.app"):
+            kept = app.plots._operating_curve("magnitude", "frequency", app.state.design, 1, 100, {}, 10.0, 0.1)
+    finally:
+        app.state.frequency_sweep = original
+    assert kept is good
+    assert len(caplog.records) == 1 and caplog.records[0].exc_info is None
+    assert "ZeroDivisionError" in caplog.records[0].getMessage()

@@ -1,0 +1,226 @@
+"""The explorer in a real browser: load, sliders, taps, links, bad input, comparison, exports."""
+
+import json
+import re
+
+import pytest
+
+from core import loads_design
+
+pytestmark = pytest.mark.usefixtures("console_errors", "no_server_tracebacks")
+
+PLOTS_JS = """() => {
+  const out = {};
+  for (const m of Bokeh.documents[0].all_models) {
+    if (m.type === 'Figure' && m.title) {
+      let total = 0, points = 0;
+      const legends = [];
+      for (const r of m.renderers) {
+        const src = r.data_source;
+        if (src && src.data) {
+          for (const col of Object.values(src.data)) {
+            if (col && col.length !== undefined && typeof col[0] === 'number') {
+              for (const v of col) { if (Number.isFinite(v)) { total += v; points++; } }
+            }
+          }
+        }
+      }
+      const parts = [...m.renderers, ...m.center, ...m.left, ...m.right, ...m.above, ...m.below];
+      for (const l of parts) {
+        if (l.items) for (const it of l.items) legends.push(it.label && (it.label.value || it.label.field));
+      }
+      const spans = parts.filter(c => c.type === 'Span').map(s => s.location);
+      out[m.title.text] = {signature: total, points, spans, legends};
+    }
+  }
+  return out;
+}"""
+
+
+def plots(page):
+    return page.evaluate(PLOTS_JS)
+
+
+def open_explorer(page, url):
+    page.goto(url)
+    page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0", timeout=30000)
+    page.locator(".bk-Canvas").nth(4).wait_for(timeout=30000)
+    wait_quiet(page)
+
+
+def wait_quiet(page, ms=600):
+    """Wait until the document has had no change for ``ms``: every update has arrived."""
+    page.evaluate(
+        """(ms) => new Promise(resolve => {
+            const doc = Bokeh.documents[0];
+            let last = performance.now();
+            const cb = () => { last = performance.now(); };
+            doc.on_change(cb);
+            const tick = () => {
+              if (performance.now() - last > ms) { doc.remove_on_change(cb); resolve(); }
+              else setTimeout(tick, 50);
+            };
+            tick();
+        })""",
+        ms,
+    )
+
+
+def by_title(page, prefix):
+    return {t: v for t, v in plots(page).items() if t.startswith(prefix)}
+
+
+def test_page_loads_with_every_plot(page, explorer_url):
+    open_explorer(page, explorer_url)
+    titles = set(plots(page))
+    assert {"|K| against frequency", "|K| against amplitude", "Loss factor against frequency",
+            "Loss factor against amplitude"} <= titles
+    assert any(t.startswith("Hysteresis loop at 0.1 mm, 10 Hz") for t in titles)
+    assert page.get_by_text("VP 40/70120 (Paper B)").count() >= 1
+    assert all(v["points"] > 0 for v in plots(page).values())
+
+
+def test_moving_a_slider_changes_every_plot(page, explorer_url):
+    open_explorer(page, explorer_url)
+    before = plots(page)
+    handle = page.locator(".noUi-handle").first  # the drive amplitude
+    handle.focus()
+    for _ in range(40):
+        handle.press("ArrowRight")
+    wait_quiet(page)
+    after = plots(page)
+    loop_title = next(t for t in after if t.startswith("Hysteresis loop"))
+    assert "0.1 mm" not in loop_title
+    for title in ("|K| against frequency", "Loss factor against frequency"):
+        assert after[title]["signature"] != before[title]["signature"], title  # the operating curve
+    for title in ("|K| against amplitude", "Loss factor against amplitude"):
+        assert after[title]["spans"][0] > before[title]["spans"][0], title  # the marker
+
+
+def test_tap_moves_the_operating_point_in_every_plot(page, explorer_url):
+    open_explorer(page, explorer_url)
+    canvas = page.locator(".bk-Canvas").nth(1)  # |K| against frequency
+    box = canvas.bounding_box()
+    canvas.click(position={"x": box["width"] * 0.6, "y": box["height"] * 0.5})
+    wait_quiet(page)
+    p = plots(page)
+    f_k = p["|K| against frequency"]["spans"][0]
+    f_eta = p["Loss factor against frequency"]["spans"][0]
+    assert f_k == pytest.approx(f_eta) and 20 < f_k < 100 and f_k != 10
+    loop_title = next(t for t in p if t.startswith("Hysteresis loop"))
+    assert f"{f_k:.3g} Hz" in loop_title
+    assert any(f"at {f_k:.3g} Hz" in (lbl or "") for lbl in p["|K| against amplitude"]["legends"])
+    # and an amplitude tap moves the amplitude everywhere
+    canvas = page.locator(".bk-Canvas").nth(4)  # loss factor against amplitude
+    box = canvas.bounding_box()
+    canvas.click(position={"x": box["width"] * 0.3, "y": box["height"] * 0.5})
+    wait_quiet(page)
+    p = plots(page)
+    x = p["Loss factor against amplitude"]["spans"][0]
+    assert x == pytest.approx(p["|K| against amplitude"]["spans"][0]) and x != 0.1
+    assert any(f"{x:.3g} mm" in t for t in p if t.startswith("Hysteresis loop"))
+
+
+def test_a_link_restores_a_design(page, explorer_url):
+    open_explorer(page, explorer_url + "?mode=torsion&a_mm=5&b_mm=11&L_mm=22&mu_MPa=2&m_MPa=0.2"
+                  "&alpha=0.4&sigma_kPa=4&eps_half=0.001&amp=0.013&f_Hz=50")
+    p = plots(page)
+    assert any(t == "Hysteresis loop at 0.013 rad, 50 Hz" for t in p)
+    assert page.get_by_text("Table 1 torsion example (Paper A)").count() >= 1
+    # and the URL follows the inputs
+    field = page.get_by_label("Length L (mm)")
+    field.fill("30")
+    field.press("Enter")
+    wait_quiet(page)
+    page.wait_for_url(re.compile(r"L_mm=30"))
+
+
+def test_invalid_value_shows_its_message_and_keeps_the_plots(page, explorer_url):
+    open_explorer(page, explorer_url)
+    before = plots(page)
+    field = page.get_by_label("Outer radius b (mm)")
+    field.fill("15")
+    field.press("Enter")
+    message = page.locator(".field-error")
+    message.wait_for(timeout=10000)
+    assert "Must be larger than the inner radius a." in message.inner_text()
+    page.get_by_text("The plots show the last valid design").first.wait_for(timeout=10000)
+    wait_quiet(page)
+    after = plots(page)
+    for title in ("|K| against frequency", "|K| against amplitude"):
+        assert after[title]["signature"] == pytest.approx(before[title]["signature"])
+    field.fill("40")  # the session goes on
+    field.press("Enter")
+    page.locator(".field-error").wait_for(state="detached", timeout=10000)
+    wait_quiet(page)
+    assert plots(page)["|K| against frequency"] != before["|K| against frequency"]
+
+
+def test_comparison_overlay_appears(page, explorer_url):
+    open_explorer(page, explorer_url)
+    page.get_by_role("button", name="Pin as reference").click()
+    wait_quiet(page)
+    field = page.get_by_label("Length L (mm)")
+    field.fill("99")
+    field.press("Enter")
+    wait_quiet(page)
+    p = plots(page)
+    assert "reference" in p["|K| against frequency"]["legends"]
+    page.get_by_text("+10.00 %").first.wait_for(timeout=10000)
+
+
+def test_exports(page, explorer_url, tmp_path):
+    open_explorer(page, explorer_url)
+    with page.expect_download() as dl:
+        page.get_by_role("button", name="Design file (JSON)").click()
+    path = tmp_path / "d.json"
+    dl.value.save_as(path)
+    assert loads_design(path.read_text()).name == "VP 40/70120 (Paper B)"
+    assert json.loads(path.read_text())["mode"] == "axial"
+    with page.expect_download() as dl:
+        page.get_by_role("button", name="Stiffness table (CSV)").click()
+    dl.value.save_as(tmp_path / "k.csv")
+    assert (tmp_path / "k.csv").read_text().startswith(
+        "frequency_hz,amplitude,stiffness_real,stiffness_imag,magnitude,loss_factor")
+    # PNG from a plot's toolbar save tool
+    canvas = page.locator(".bk-Canvas").nth(1)
+    canvas.hover()
+    with page.expect_download() as dl:
+        page.locator(".bk-tool-icon-save").nth(1).click()
+    assert dl.value.suggested_filename == "bushing-magnitude-vs-frequency.png"
+    dl.value.save_as(tmp_path / "plot.png")
+    assert (tmp_path / "plot.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_slices_tap_and_teaching_play(page, explorer_url):
+    open_explorer(page, explorer_url)
+    page.get_by_text("Slices", exact=True).click()
+    page.wait_for_function(
+        "() => [...Bokeh.documents[0].all_models].some(m => m.type === 'Figure' && m.title && m.title.text.startsWith('|K|: single'))",
+        timeout=20000,
+    )
+    wait_quiet(page)
+    canvas = page.locator(".bk-Canvas").first
+    box = canvas.bounding_box()
+    canvas.click(position={"x": box["width"] * 0.25, "y": box["height"] * 0.5})
+    wait_quiet(page)
+    spans = plots(page)["|K|: single modulus, slices and continuum"]["spans"]
+    assert spans and spans[0] != 0.1
+    assert page.get_by_text("3 slices").count() >= 1
+    page.get_by_text("Fletcher–Gent, branch by branch", exact=True).click()
+    page.wait_for_function(
+        "() => [...Bokeh.documents[0].all_models].some(m => m.type === 'Figure' && m.title && m.title.text.startsWith('Loop shape'))",
+        timeout=20000,
+    )
+    wait_quiet(page)
+
+    def loop_title():
+        return next(t for t in plots(page) if t.startswith("Loop shape"))
+
+    first = loop_title()
+    page.locator("button.play").click()
+    page.wait_for_function(
+        "(first) => [...Bokeh.documents[0].all_models].some(m => m.type === 'Figure' && m.title && m.title.text.startsWith('Loop shape') && m.title.text !== first)",
+        arg=first, timeout=20000,
+    )
+    assert loop_title() != first
