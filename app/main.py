@@ -6,7 +6,6 @@ import logging
 import os
 import sys
 
-import holoviews as hv
 import panel as pn
 
 from .state import ExplorerState
@@ -21,7 +20,6 @@ from .views import (
     status_banner,
 )
 
-hv.extension("bokeh", logo=False)
 pn.extension(throttled=False)
 
 TITLE = "Bushing Explorer"
@@ -63,6 +61,13 @@ class App(pn.viewable.Viewer):
             dynamic=True,
             sizing_mode="stretch_width",
         )
+        self._tab_views = {0: self.plots, 1: self.slices, 2: self.teaching}
+        self.tabs.param.watch(self._on_tab, "active")
+        self._on_tab()
+
+    def _on_tab(self, *_events):
+        for index, view in self._tab_views.items():
+            view.show(index == self.tabs.active)
 
     def sync_url(self):
         """Put the whole design in the URL, and read one from it (a shared link)."""
@@ -76,6 +81,7 @@ class App(pn.viewable.Viewer):
             main=[status_banner(self.state), self.tabs],
             sidebar_width=380,
             header_background="#1f5f8b",
+            busy_indicator=None,  # its animation restyled the page on every change
         )
         return template
 

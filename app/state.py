@@ -14,8 +14,8 @@ import numpy as np
 import param
 
 from core import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material
-from core.design import as_dict
 from core.bushing import branch_stiffness, loop, stiffness, strain_factor
+from core.design import as_dict
 from core.material import ConvergenceError
 
 # display parameter → (design key, factor from display unit to SI)

@@ -1,73 +1,42 @@
 """Panel views of an :class:`~app.state.ExplorerState`: thin presentation, no physics.
 
-Flow: widgets → the state → (cached) core → HoloViews elements → panes. Each plot is an
-overlay of DynamicMaps, one element type per map, over functions of the state.
+Flow: widgets → the state → (cached) core → data → figures (:mod:`app.figures`) → panes. A
+change of the state refreshes each view's figures once, in one message.
 """
 
 from __future__ import annotations
 
-import functools
 import io
-import json
 import logging
 import math
+import typing
 
-import holoviews as hv
 import numpy as np
 import panel as pn
-import param
-from bokeh.models import CustomJSTickFormatter, SaveTool
-from holoviews import streams
+from bokeh.models import CustomJSTickFormatter, DataRange1d
 
 from core.design import dumps_design
 
 from . import plots
-from .state import DESIGN_FIELDS, PRESETS, ExplorerState
+from .figures import Axis, Figure
+from .state import AMPLITUDE_DISPLAY, DESIGN_FIELDS, FORCE_DISPLAY, STIFFNESS_DISPLAY, ExplorerState
 
 log = logging.getLogger("bushing.app")
 
-PLOT_OPTS = {
-    "responsive": True,
-    "min_height": 260,
-    "tools": ["hover", "tap"],
-    "active_tools": ["tap", "wheel_zoom"],
-    "framewise": True,
-    "show_grid": True,
-}
-
-
-def png_name(filename: str):
-    """A HoloViews hook that names the PNG of the plot's save tool (no filename prompt)."""
-
-    def hook(plot, _element):
-        for tool in plot.state.toolbar.tools:
-            if isinstance(tool, SaveTool):
-                tool.filename = filename
-
-    return hook
-
-
-def guarded(fn):
-    """A plot callback that never raises: on an unexpected error it logs one line (no
-    traceback) and shows the last good element."""
-    last = {}
-
-    @functools.wraps(fn)
-    def wrapper(*args, **kwargs):
-        try:
-            out = fn(*args, **kwargs)
-        except Exception as exc:  # noqa: BLE001 - keep the last good plot, say what happened
-            log.warning("%s kept its last plot: %s: %s", fn.__name__, type(exc).__name__, exc)
-            if "element" in last:
-                return last["element"]
-            raise
-        last["element"] = out
-        return out
-
-    return wrapper
-
-
 # ---- inputs --------------------------------------------------------------------------------
+
+
+class FloatInput(pn.widgets.FloatInput):
+    """Panel's FloatInput without the 50 ms debounce on its value: every edit answers at once
+    (Panel marks such properties as priority changes, as its Tabulator does for its data)."""
+
+    _priority_changes: typing.ClassVar[list[str]] = ["value"]
+
+
+class FloatSlider(pn.widgets.FloatSlider):
+    """Panel's FloatSlider without the 50 ms debounce on its value (see :class:`FloatInput`)."""
+
+    _priority_changes: typing.ClassVar[list[str]] = ["value"]
 
 
 class LogSlider(pn.viewable.Viewer):
@@ -78,7 +47,7 @@ class LogSlider(pn.viewable.Viewer):
         self._state, self._name, self._bounds, self._unit = state, name, bounds, unit
         p = state.param[name]
         lo, hi = bounds()
-        self.slider = pn.widgets.FloatSlider(
+        self.slider = FloatSlider(
             label=self._label(),
             start=math.log10(lo),
             end=math.log10(hi),
@@ -142,14 +111,14 @@ class DesignInputs(pn.viewable.Viewer):
         self.state = state
         steps = {"fractional_order": 0.05, "friction_strain_half": 5e-4}
         self.widgets = {
-            name: pn.widgets.FloatInput.from_param(
+            name: FloatInput.from_param(
                 state.param[name], description=state.param[name].doc, step=steps.get(name, 0.5),
                 sizing_mode="stretch_width", label=state.param[name].label,
             )
             for name in DESIGN_FIELDS
         }
         for name in ("freq_min", "freq_max"):
-            self.widgets[name] = pn.widgets.FloatInput.from_param(
+            self.widgets[name] = FloatInput.from_param(
                 state.param[name], description=state.param[name].doc, step=1.0,
                 sizing_mode="stretch_width", label=state.param[name].label,
             )
@@ -186,273 +155,312 @@ class DesignInputs(pn.viewable.Viewer):
 # ---- plots ---------------------------------------------------------------------------------
 
 
-class ExplorerPlots(pn.viewable.Viewer):
-    """Loop, |K| and loss factor against frequency and amplitude, linked by the operating
-    point: a tap on a frequency axis sets the frequency, on an amplitude axis the amplitude."""
+def _axes(mode):
+    """The plotted quantities, with the units of the mode."""
+    amp_unit = AMPLITUDE_DISPLAY[mode][0]
+    return {
+        "frequency": Axis("frequency_hz", "Frequency", "Hz"),
+        "amplitude": Axis("amplitude", "Amplitude", amp_unit),
+        "magnitude": Axis("magnitude", "|K|", STIFFNESS_DISPLAY[mode][0]),
+        "loss_factor": Axis("loss_factor", "Loss factor"),
+        "displacement": Axis("displacement", "Displacement" if mode == "axial" else "Angle", amp_unit),
+        "force": Axis("force", "Force" if mode == "axial" else "Moment", FORCE_DISPLAY[mode][0]),
+        "difference": Axis("difference", "Difference", "%"),
+        "real": Axis("real", "Re K", STIFFNESS_DISPLAY[mode][0]),
+    }
+
+
+class PlotView(pn.viewable.Viewer):
+    """Figures refreshed together, in one message, when the state parameters they show change.
+    A refresh never raises: an unexpected error is logged in one line and the last plots stay."""
+
+    WATCH: tuple = ()
 
     def __init__(self, state: ExplorerState, **params):
         super().__init__(**params)
         self.state = state
-        s = state.param
-        design_deps = {"design": s.design, "fmin": s.freq_min, "fmax": s.freq_max, "errors": s.errors}
-        op = {"f": s.frequency_hz, "x": s.amplitude}
-        ref = {"reference": s.reference}
+        self.figures: dict = {}
+        self._mode = None
+        self._shown = True
+        self._stale = False
 
-        self.loop = (
-            hv.DynamicMap(pn.bind(self._loop_branches, **design_deps, **op))
-            * hv.DynamicMap(pn.bind(self._loop_reference, **design_deps, **op, **ref))
-            * hv.DynamicMap(pn.bind(self._loop_total, **design_deps, **op))
-        ).opts(
-            hv.opts.Curve(responsive=True, min_height=300, framewise=True, show_grid=True, tools=["hover"], line_width=1.5),
-            hv.opts.Overlay(legend_position="top_left", hooks=[png_name("bushing-hysteresis-loop")]),
-        )
+    def _start(self):
+        self.state.param.watch(self._on_change, list(self.WATCH))
+        self.refresh()
 
+    def _on_change(self, *_events):
+        if self._shown:
+            self.refresh()
+        else:
+            self._stale = True  # a hidden tab catches up when shown
+
+    def show(self, shown: bool):
+        """Tell the view whether its tab is on screen."""
+        self._shown = shown
+        if shown and self._stale:
+            self._stale = False
+            self.refresh()
+
+    def refresh(self):
+        try:
+            with pn.io.hold():
+                mode = self.state.design.mode
+                if mode != self._mode:
+                    self._mode = mode
+                    self._set_axes(_axes(mode))
+                self._update()
+        except Exception as exc:  # noqa: BLE001 - keep the last plots, say what happened
+            log.warning("%s kept its last plots: %s: %s", type(self).__name__, type(exc).__name__, exc)
+
+    def _set_axes(self, axes):
+        raise NotImplementedError
+
+    def _update(self):
+        raise NotImplementedError
+
+    def _tap_amplitude(self, x):
+        if x is not None and np.isfinite(x) and x > 0:
+            lo, hi = self.state.amplitude_bounds
+            self.state.amplitude = float(np.clip(float(f"{x:.4g}"), lo, hi))
+
+    def _tap_frequency(self, x):
+        if x is not None and np.isfinite(x) and x > 0:
+            self.state.frequency_hz = float(np.clip(float(f"{x:.4g}"), 0.1, 1000.0))
+
+
+class ExplorerPlots(PlotView):
+    """Loop, |K| and loss factor against frequency and amplitude, linked by the operating
+    point: a tap on a frequency axis sets the frequency, on an amplitude axis the amplitude."""
+
+    WATCH = ("design", "freq_min", "freq_max", "errors", "frequency_hz", "amplitude", "reference")
+    def __init__(self, state: ExplorerState, **params):
+        super().__init__(state, **params)
+        axes = _axes(state.design.mode)
+        shared = {name: DataRange1d() for name in ("frequency", "amplitude", "magnitude", "loss_factor")}
+        self.loop = Figure("Hysteresis loop at the operating point", axes["displacement"], axes["force"],
+                           height=330, png="bushing-hysteresis-loop", legend="inside")
+        for name, color in plots.BRANCH_COLORS.items():
+            self.loop.line(name, name, color=color, line_width=1.5)
+        self.loop.line("reference", "reference", **plots.REFERENCE_STYLE)
+        self.loop.line("total", "total", color="black", line_width=2.5)
         titles = {
             ("magnitude", "frequency"): "|K| against frequency",
             ("loss_factor", "frequency"): "Loss factor against frequency",
             ("magnitude", "amplitude"): "|K| against amplitude",
             ("loss_factor", "amplitude"): "Loss factor against amplitude",
         }
-        self.panels, self.taps = {}, []
-        for quantity in ("magnitude", "loss_factor"):
-            for axis in ("frequency", "amplitude"):
-                logx = axis == "amplitude"
-                operating = hv.DynamicMap(
-                    pn.bind(self._operating_curve, quantity=quantity, axis=axis, **design_deps, **op)
-                ).opts(hv.opts.Curve(**PLOT_OPTS, logx=logx))
-                # a linked stream attaches to a map of single elements, not to an overlay
-                tap = streams.Tap(source=operating, x=None, y=None)
-                tap.add_subscriber(functools.partial(self._on_tap, axis))
-                self.taps.append(tap)
-                self.panels[(quantity, axis)] = (
-                    hv.DynamicMap(pn.bind(self._sweep, quantity=quantity, axis=axis, **design_deps, **op))
-                    * hv.DynamicMap(pn.bind(self._reference_curve, quantity=quantity, axis=axis, **design_deps, **op, **ref))
-                    * operating
-                    * hv.DynamicMap(pn.bind(self._marker, axis=axis, **op))
-                ).opts(
-                    hv.opts.Curve(**PLOT_OPTS, logx=logx),
-                    hv.opts.VLine(color=plots.OPERATING_COLOR, line_width=1.5, line_dash="dotted"),
-                    hv.opts.NdOverlay(legend_position="right"),
-                    hv.opts.Overlay(title=titles[(quantity, axis)], logx=logx,
-                                    hooks=[png_name(f"bushing-{quantity}-vs-{axis}")]),
-                )
+        for (quantity, axis), title in titles.items():
+            fig = Figure(title, axes[axis], axes[quantity], x_log=axis == "amplitude",
+                         x_range=shared[axis], y_range=shared[quantity], marker=True,
+                         png=f"bushing-{quantity}-vs-{axis}")
+            palette = plots.SWEEP_PALETTES["amplitude" if axis == "frequency" else "frequency"]
+            n = len(state.sweep_amplitudes() if axis == "frequency" else state.sweep_frequencies())
+            fig.lines("sweeps", [""] * n, palette, line_width=1.3)
+            fig.line("reference", "reference", **plots.REFERENCE_STYLE)
+            fig.line("operating", "operating point", color=plots.OPERATING_COLOR, line_width=3)
+            fig.on_tap(self._tap_frequency if axis == "frequency" else self._tap_amplitude)
+            self.figures[(quantity, axis)] = fig
+        self.summary = pn.pane.HTML("", sizing_mode="stretch_width", css_classes=["operating-point"],
+                                    margin=(0, 10))
+        self._start()
 
-    # data → elements (each callback one element type)
+    def _set_axes(self, axes):
+        self.loop.set_axes(axes["displacement"], axes["force"])
+        for (quantity, axis), fig in self.figures.items():
+            fig.set_axes(axes[axis], axes[quantity])
 
-    @guarded
-    def _loop_total(self, design, fmin, fmax, errors, f, x):
-        return plots.loop_total(self.state.hysteresis_loop(), design.mode).opts(
-            color="black", line_width=2.5,
-            title=f"Hysteresis loop at {x:.3g} {self.state.amplitude_unit}, {f:.3g} Hz",
-        )
-
-    @guarded
-    def _loop_branches(self, design, fmin, fmax, errors, f, x):
-        return plots.loop_branches(self.state.hysteresis_loop(), design.mode)
-
-    @guarded
-    def _loop_reference(self, design, fmin, fmax, errors, f, x, reference):
-        mode = design.mode
-        if reference is None or reference.mode != mode:
-            return plots.loop_total({"displacement": [], "force": []}, mode, label="")
-        return plots.loop_total(self.state.hysteresis_loop(reference), mode, label="reference").opts(**plots.REFERENCE_STYLE)
-
-    def _sweep_data(self, axis, design=None):
-        if axis == "frequency":
-            return self.state.frequency_sweep(design)
-        return self.state.amplitude_sweep(design)
-
-    def _dims(self, quantity, axis, mode):
-        xdim = plots.FREQUENCY if axis == "frequency" else plots.amplitude_dim(mode)
-        ydim = plots.magnitude_dim(mode) if quantity == "magnitude" else plots.LOSS
-        return xdim, ydim
-
-    @guarded
-    def _sweep(self, quantity, axis, design, fmin, fmax, errors, f, x):
-        data = self._sweep_data(axis)
-        xdim, ydim = self._dims(quantity, axis, design.mode)
-        if axis == "frequency":
-            keys, key_label, unit, xs = data["amplitude"], "amplitude", self.state.amplitude_unit, data["frequency_hz"]
+    def _update(self):
+        s = self.state
+        lp = s.hysteresis_loop()
+        for name in (*plots.BRANCH_COLORS, "total"):
+            key = "force" if name == "total" else f"force_{name}"
+            self.loop.set(name, x=lp["displacement"], y=lp[key])
+        ref = s.reference if s.reference is not None and s.reference.mode == s.design.mode else None
+        if ref is not None:
+            rl = s.hysteresis_loop(ref)
+            self.loop.set("reference", x=rl["displacement"], y=rl["force"])
         else:
-            keys, key_label, unit, xs = data["frequency_hz"], "frequency", "Hz", data["amplitude"]
-        return plots.sweep_overlay(xs, xdim, data[quantity], ydim, keys, key_label, unit).opts(
-            hv.opts.Curve(line_width=1.3)
+            self.loop.clear("reference")
+        sweeps = {"frequency": s.frequency_sweep(), "amplitude": s.amplitude_sweep()}
+        operating = {"frequency": s.frequency_sweep(amplitudes=s.amplitude),
+                     "amplitude": s.amplitude_sweep(frequencies=s.frequency_hz)}
+        reference = ({"frequency": s.frequency_sweep(ref, amplitudes=s.amplitude),
+                      "amplitude": s.amplitude_sweep(ref, frequencies=s.frequency_hz)} if ref else None)
+        for (quantity, axis), fig in self.figures.items():
+            data = sweeps[axis]
+            xs = data["frequency_hz"] if axis == "frequency" else data["amplitude"]
+            keys = data["amplitude"] if axis == "frequency" else data["frequency_hz"]
+            unit = s.amplitude_unit if axis == "frequency" else "Hz"
+            fig.set_lines("sweeps", xs, data[quantity], [plots.sweep_label(k, unit) for k in keys])
+            op = operating[axis]
+            fig.set("operating", x=xs, y=op[quantity][0])
+            if reference:
+                fig.set("reference", x=xs, y=reference[axis][quantity][0])
+            else:
+                fig.clear("reference")
+            fig.set_marker(s.frequency_hz if axis == "frequency" else s.amplitude)
+        point = s.operating_point()
+        self.summary.object = (
+            f'<span class="op-summary"><b>Operating point</b>: <span class="op-point">{s.amplitude:.3g} '
+            f"{s.amplitude_unit}, {s.frequency_hz:.3g} Hz</span> &nbsp;→&nbsp; |K| = "
+            f"<b>{point['magnitude']:.4g} {s.stiffness_unit}</b>, loss factor <b>{point['loss_factor']:.4f}</b></span>"
         )
-
-    def _operating_data(self, axis, design):
-        if axis == "frequency":
-            d = self.state.frequency_sweep(design, amplitudes=self.state.amplitude)
-            return d["frequency_hz"], d
-        d = self.state.amplitude_sweep(design, frequencies=self.state.frequency_hz)
-        return d["amplitude"], d
-
-    @guarded
-    def _operating_curve(self, quantity, axis, design, fmin, fmax, errors, f, x):
-        xs, d = self._operating_data(axis, design)
-        xdim, ydim = self._dims(quantity, axis, design.mode)
-        label = f"at {x:.3g} {self.state.amplitude_unit}" if axis == "frequency" else f"at {f:.3g} Hz"
-        return plots.operating_curve(xs, xdim, d[quantity][0], ydim, label).opts(color=plots.OPERATING_COLOR, line_width=3)
-
-    @guarded
-    def _reference_curve(self, quantity, axis, design, fmin, fmax, errors, f, x, reference):
-        xdim, ydim = self._dims(quantity, axis, design.mode)
-        if reference is None or reference.mode != design.mode:
-            return plots.operating_curve([], xdim, [], ydim, "")
-        xs, d = self._operating_data(axis, reference)
-        return plots.operating_curve(xs, xdim, d[quantity][0], ydim, "reference").opts(**plots.REFERENCE_STYLE)
-
-    @guarded
-    def _marker(self, axis, f, x):
-        return plots.marker(f if axis == "frequency" else x)
-
-    def _on_tap(self, axis, x, y):
-        if x is None or not np.isfinite(x):
-            return
-        if axis == "frequency":
-            self.state.frequency_hz = float(np.clip(float(f"{x:.4g}"), 0.1, 1000.0))
-        else:
-            lo, hi = self.state.amplitude_bounds
-            self.state.amplitude = float(np.clip(float(f"{x:.4g}"), lo, hi))
 
     def __panel__(self):
-        def pane(key):  # separate panes: Panel links the axes of dimensions they share
-            return pn.pane.HoloViews(self.panels[key], sizing_mode="stretch_width", height=300)
+        def pane(fig, height=300):
+            return pn.pane.Bokeh(fig.fig, sizing_mode="stretch_width", height=height)
 
+        f = self.figures
         return pn.Column(
-            pn.pane.HoloViews(self.loop, sizing_mode="stretch_width", height=340, linked_axes=False),
-            pn.Row(pane(("magnitude", "frequency")), pane(("magnitude", "amplitude")), sizing_mode="stretch_width"),
-            pn.Row(pane(("loss_factor", "frequency")), pane(("loss_factor", "amplitude")), sizing_mode="stretch_width"),
+            self.summary,
+            pane(self.loop, 330),
+            pn.Row(pane(f[("magnitude", "frequency")]), pane(f[("magnitude", "amplitude")]), sizing_mode="stretch_width"),
+            pn.Row(pane(f[("loss_factor", "frequency")]), pane(f[("loss_factor", "amplitude")]), sizing_mode="stretch_width"),
             sizing_mode="stretch_width",
         )
 
 
-class SlicesView(pn.viewable.Viewer):
+class SlicesView(PlotView):
     """Paper A: one equivalent modulus against 2 and 3 slices and the continuum."""
 
+    WATCH = ("design", "errors", "frequency_hz", "amplitude")
+    NAMES: typing.ClassVar = {1: "1 slice (eqs 17/18)", 2: "2 slices", 3: "3 slices", "continuum": "continuum"}
+
     def __init__(self, state: ExplorerState, **params):
-        super().__init__(**params)
-        self.state = state
-        s = state.param
-        deps = {"design": s.design, "f": s.frequency_hz, "errors": s.errors}
-        opts = [hv.opts.Curve(**PLOT_OPTS, logx=True), hv.opts.NdOverlay(legend_position="right"),
-                hv.opts.VLine(color=plots.OPERATING_COLOR, line_dash="dotted")]
-        titles = {
-            "magnitude": "|K|: single modulus, slices and continuum",
-            "magnitude_diff_pct": "|K| difference from the single modulus (%)",
-            "loss_factor": "Loss factor",
+        super().__init__(state, **params)
+        axes = _axes(state.design.mode)
+        shared_x = DataRange1d()
+        specs = {
+            "magnitude": ("|K|: single modulus, slices and continuum", axes["magnitude"], (1, 2, 3, "continuum")),
+            "magnitude_diff_pct": ("|K| difference from the single modulus (%)", axes["difference"], (2, 3, "continuum")),
+            "loss_factor": ("Loss factor", axes["loss_factor"], (1, 2, 3, "continuum")),
         }
-        self.overlays = {}
-        for which, title in titles.items():
-            curves = hv.DynamicMap(pn.bind(self._curves, which=which, **deps)).opts(*opts)
-            marker = hv.DynamicMap(pn.bind(plots.marker, s.amplitude)).opts(*opts)
-            # a linked stream attaches to a map of single elements, not to an overlay
-            streams.Tap(source=marker, x=None, y=None).add_subscriber(self._on_tap)
-            self.overlays[which] = (curves * marker).opts(
-                *opts, hv.opts.Overlay(title=title, logx=True, hooks=[png_name(f"bushing-slices-{which}")]))
+        for which, (title, y, models) in specs.items():
+            fig = Figure(title, axes["amplitude"], y, x_log=True, x_range=shared_x, marker=True,
+                         png=f"bushing-slices-{which}", height=280)
+            for m in models:
+                fig.line(str(m), self.NAMES[m], color=plots.SLICE_COLORS[m], line_width=2)
+            fig.on_tap(self._tap_amplitude)
+            self.figures[which] = fig
+        self.table = pn.pane.Markdown("", sizing_mode="stretch_width")
+        self._start()
 
-    @guarded
-    def _curves(self, which, design, f, errors):
+    def _set_axes(self, axes):
+        ys = {"magnitude": axes["magnitude"], "magnitude_diff_pct": axes["difference"], "loss_factor": axes["loss_factor"]}
+        for which, fig in self.figures.items():
+            fig.set_axes(axes["amplitude"], ys[which])
+
+    def _update(self):
         data = self.state.slice_comparison()
-        mode = design.mode
-        ydim = {
-            "magnitude": plots.magnitude_dim(mode),
-            "loss_factor": plots.LOSS,
-            "magnitude_diff_pct": hv.Dimension("difference", label="Difference", unit="%"),
-        }[which]
-        return plots.slice_curves(data["amplitude"], mode, data[which], ydim)
+        for which, fig in self.figures.items():
+            for m in fig.sources:
+                key = "continuum" if m == "continuum" else int(m)
+                if key in data[which]:
+                    fig.set(m, x=data["amplitude"], y=data[which][key])
+                else:
+                    fig.clear(m)
+            fig.set_marker(self.state.amplitude)
+        self.table.object = self.summary(data)
 
-    def _on_tap(self, x, y):
-        if x is not None and np.isfinite(x):
-            lo, hi = self.state.amplitude_bounds
-            self.state.amplitude = float(np.clip(float(f"{x:.4g}"), lo, hi))
-
-    def summary(self, design, f, x):
-        data = self.state.slice_comparison()
-        xs = data["amplitude"]
+    def summary(self, data):
+        xs, unit = data["amplitude"], self.state.amplitude_unit
         rows = ["| model | largest \\|K\\| difference | largest loss-factor difference |", "|---|---|---|"]
         for s in (2, 3, "continuum"):
             if s in data["magnitude_diff_pct"]:
                 dm, de = data["magnitude_diff_pct"][s], data["loss_factor_diff_pct"][s]
                 im, ie = int(np.argmax(np.abs(dm))), int(np.argmax(np.abs(de)))
-                rows.append(
-                    f"| {s} {'slices' if s != 'continuum' else ''} | {dm[im]:+.2f} % at {xs[im]:.3g} {self.state.amplitude_unit} "
-                    f"| {de[ie]:+.2f} % at {xs[ie]:.3g} {self.state.amplitude_unit} |"
-                )
+                rows.append(f"| {self.NAMES[s]} | {dm[im]:+.2f} % at {xs[im]:.3g} {unit} "
+                            f"| {de[ie]:+.2f} % at {xs[ie]:.3g} {unit} |")
+        missing = [self.NAMES[s] for s in (2, 3, "continuum") if s not in data["magnitude"]]
+        if missing:
+            rows.append(f"\n_Not shown, the iteration did not converge: {', '.join(missing)}._")
         return "\n".join(rows)
 
     def __panel__(self):
-        s = self.state.param
         return pn.Column(
             pn.pane.Markdown(
                 "Paper A splits the rubber into concentric slices of equal thickness, each with "
                 "its own equivalent strain; the continuum takes infinitely many. The single "
                 "equivalent modulus (eqs 17/18) is close when the differences below are small. "
-                "All at the loop frequency.", sizing_mode="stretch_width"),
-            pn.pane.Markdown(pn.bind(self.summary, s.design, s.frequency_hz, s.amplitude), sizing_mode="stretch_width"),
-            pn.pane.HoloViews(self.overlays["magnitude"], sizing_mode="stretch_width", height=300),
-            pn.pane.HoloViews(self.overlays["magnitude_diff_pct"], sizing_mode="stretch_width", height=260),
-            pn.pane.HoloViews(self.overlays["loss_factor"], sizing_mode="stretch_width", height=260),
+                "All at the loop frequency; tap a plot to move the amplitude.", sizing_mode="stretch_width"),
+            self.table,
+            *(pn.pane.Bokeh(f.fig, sizing_mode="stretch_width", height=280) for f in self.figures.values()),
             sizing_mode="stretch_width",
         )
 
 
-class TeachingView(pn.viewable.Viewer):
+class TeachingView(PlotView):
     """The Fletcher–Gent effect branch by branch, and the loop changing as amplitude sweeps."""
 
+    WATCH = ("design", "errors", "frequency_hz", "amplitude")
+    FRAMES = 48
+
     def __init__(self, state: ExplorerState, **params):
-        super().__init__(**params)
-        self.state = state
-        s = state.param
-        deps = {"design": s.design, "f": s.frequency_hz, "errors": s.errors}
-        self.frames = 48
+        super().__init__(state, **params)
+        axes = _axes(state.design.mode)
+        shared_x = DataRange1d()
         self.player = pn.widgets.Player(
-            label="Amplitude sweep", start=0, end=self.frames - 1, value=self.frames // 2,
+            label="Amplitude sweep", start=0, end=self.FRAMES - 1, value=self.FRAMES // 2,
             loop_policy="loop", interval=150, show_value=False, show_loop_controls=False,
             sizing_mode="stretch_width",
         )
-        marker = hv.DynamicMap(pn.bind(lambda x: plots.marker(x), x=s.amplitude))
-        opts = [hv.opts.Area(**{k: v for k, v in PLOT_OPTS.items() if k not in ("tools", "active_tools")}, logx=True, fill_alpha=0.55, line_width=1),
-                hv.opts.Overlay(legend_position="top_right"), hv.opts.VLine(color=plots.OPERATING_COLOR, line_dash="dotted")]
-        self.real = (hv.DynamicMap(pn.bind(self._areas, which="real", **deps)) * marker).opts(
-            *opts, hv.opts.Overlay(title="Re K, branch by branch (stacked)", logx=True,
-                                   hooks=[png_name("bushing-branches-stiffness")]))
-        self.loss = (hv.DynamicMap(pn.bind(self._areas, which="loss", **deps)) * marker).opts(
-            *opts, hv.opts.Overlay(title="Loss factor, branch by branch (stacked)", logx=True,
-                                   hooks=[png_name("bushing-branches-loss-factor")]))
-        self.loop = hv.DynamicMap(pn.bind(self._loop_frame, frame=self.player.param.value, **deps)).opts(
-            hv.opts.Curve(responsive=True, min_height=300, framewise=False, tools=["hover"]),
-            hv.opts.NdOverlay(legend_position="top_left", xlim=(-1.05, 1.05), ylim=(-1.1, 1.1),
-                              hooks=[png_name("bushing-loop-shape")]),
-        )
+        for which, title, y in (("real", "Re K, branch by branch (stacked)", axes["real"]),
+                                ("loss", "Loss factor, branch by branch (stacked)", axes["loss_factor"])):
+            fig = Figure(title, axes["amplitude"], y, x_log=True, x_range=shared_x, marker=True,
+                         png=f"bushing-branches-{which}", legend="inside", hover=False)
+            for name, color in plots.BRANCH_COLORS.items():
+                fig.band(name, name, color=color, fill_alpha=0.55)
+            fig.on_tap(self._tap_amplitude)
+            self.figures[which] = fig
+        rel = (Axis("x_rel", "Drive / peak drive"), Axis("f_rel", "Force / peak force"))
+        self.loop = Figure("Loop shape during the amplitude sweep", *rel, height=420,
+                           png="bushing-loop-shape", legend="inside", x_range=DataRange1d(start=-1.05, end=1.05),
+                           y_range=DataRange1d(start=-1.1, end=1.1))
+        self.loop.line("total", "total", color="black", line_width=2.5)
+        for name, color in plots.BRANCH_COLORS.items():
+            self.loop.line(name, name, color=color, line_width=1.5)
+        self.frame_label = pn.pane.HTML("", css_classes=["loop-frame"], margin=(0, 10))
+        self.player.param.watch(lambda _e: self._frame(), "value")
+        self._start()
 
-    def _frame_amplitudes(self):
-        return np.geomspace(*self.state.amplitude_bounds, self.frames)
+    def _set_axes(self, axes):
+        self.figures["real"].set_axes(axes["amplitude"], axes["real"])
+        self.figures["loss"].set_axes(axes["amplitude"], axes["loss_factor"])
 
-    @guarded
-    def _areas(self, which, design, f, errors):
-        data = self.state.branch_breakdown()
-        mode = design.mode
-        ydim = plots.magnitude_dim(mode) if which == "real" else plots.LOSS
-        if which == "real":
-            ydim = hv.Dimension("real", label="Re K", unit=ydim.unit)
-        return plots.stacked_areas(data["amplitude"], plots.amplitude_dim(mode), data[which], ydim)
+    def _update(self):
+        d = self.state.branch_breakdown()
+        for which, fig in self.figures.items():
+            base = np.zeros_like(d["amplitude"])
+            for name in plots.BRANCH_COLORS:
+                top = base + d[which][name]
+                fig.set(name, x=d["amplitude"], y1=base, y2=top)
+                base = top
+            fig.set_marker(self.state.amplitude)
+        self._frame()
 
-    @guarded
-    def _loop_frame(self, frame, design, f, errors):
-        x = self._frame_amplitudes()[frame]
-        data = self.state.hysteresis_loop(amplitude=x)
-        return plots.normalised_loop(data).opts(
-            hv.opts.NdOverlay(title=f"Loop shape at {x:.3g} {self.state.amplitude_unit}, {f:.3g} Hz"),
-        )
+    def _frame(self):
+        try:
+            with pn.io.hold():
+                x = np.geomspace(*self.state.amplitude_bounds, self.FRAMES)[self.player.value]
+                data = self.state.hysteresis_loop(amplitude=x)
+                xn = data["displacement"] / np.max(np.abs(data["displacement"]))
+                peak = np.max(np.abs(data["force"]))
+                self.loop.set("total", x=xn, y=data["force"] / peak)
+                for name in plots.BRANCH_COLORS:
+                    self.loop.set(name, x=xn, y=data[f"force_{name}"] / peak)
+                self.frame_label.object = (f'<span class="frame-point">Loop shape at <b>{x:.3g} '
+                                           f"{self.state.amplitude_unit}</b>, {self.state.frequency_hz:.3g} Hz</span>")
+        except Exception as exc:  # noqa: BLE001 - keep the last frame
+            log.warning("TeachingView kept its last frame: %s: %s", type(exc).__name__, exc)
 
     def __panel__(self):
         return pn.Column(
             pn.pane.Markdown(TEACHING_TEXT, sizing_mode="stretch_width"),
             pn.Row(
-                pn.Column(pn.pane.HoloViews(self.real, sizing_mode="stretch_width", height=300),
-                          pn.pane.HoloViews(self.loss, sizing_mode="stretch_width", height=300),
-                          sizing_mode="stretch_width"),
-                pn.Column(self.player, pn.pane.HoloViews(self.loop, sizing_mode="stretch_width", height=420),
+                pn.Column(*(pn.pane.Bokeh(f.fig, sizing_mode="stretch_width", height=300)
+                            for f in self.figures.values()), sizing_mode="stretch_width"),
+                pn.Column(self.player, self.frame_label,
+                          pn.pane.Bokeh(self.loop.fig, sizing_mode="stretch_width", height=420),
                           sizing_mode="stretch_width"),
                 sizing_mode="stretch_width",
             ),
@@ -471,6 +479,11 @@ amplitude it saturates at σ_fmax and both its stiffness and its share of the lo
 to watch the loop change shape: a thin ellipse at small amplitude, a fat friction loop near the
 knee, a sheared parallelogram at large amplitude.
 """
+
+
+def pct(value: float) -> str:
+    """A signed percentage to 2 decimals, without a "-0.00" from round-off."""
+    return f"{0.0 if abs(value) < 0.005 else value:+.2f} %"
 
 
 class CompareView(pn.viewable.Viewer):
@@ -494,11 +507,11 @@ class CompareView(pn.viewable.Viewer):
         (m_now, m_ref, m_d), (e_now, e_ref, e_d) = c["operating"]["magnitude"], c["operating"]["loss_factor"]
         return (
             f"| at {f:.3g} Hz, {x:.3g} {self.state.amplitude_unit} | this design | reference | difference |\n|---|---|---|---|\n"
-            f"| \\|K\\| ({unit}) | {m_now:.4g} | {m_ref:.4g} | {m_d:+.2f} % |\n"
-            f"| loss factor | {e_now:.4f} | {e_ref:.4f} | {e_d:+.2f} % |\n\n"
-            f"Largest difference over the frequency sweep: \\|K\\| {c['largest_over_frequency']['magnitude']:+.2f} %, "
-            f"loss factor {c['largest_over_frequency']['loss_factor']:+.2f} %; over the amplitude sweep: "
-            f"\\|K\\| {c['largest_over_amplitude']['magnitude']:+.2f} %, loss factor {c['largest_over_amplitude']['loss_factor']:+.2f} %."
+            f"| \\|K\\| ({unit}) | {m_now:.4g} | {m_ref:.4g} | {pct(m_d)} |\n"
+            f"| loss factor | {e_now:.4f} | {e_ref:.4f} | {pct(e_d)} |\n\n"
+            f"Largest difference over the frequency sweep: \\|K\\| {pct(c['largest_over_frequency']['magnitude'])}, "
+            f"loss factor {pct(c['largest_over_frequency']['loss_factor'])}; over the amplitude sweep: "
+            f"\\|K\\| {pct(c['largest_over_amplitude']['magnitude'])}, loss factor {pct(c['largest_over_amplitude']['loss_factor'])}."
         )
 
     def __panel__(self):
@@ -549,19 +562,24 @@ class ExportView(pn.viewable.Viewer):
 
 
 def status_banner(state: ExplorerState):
+    """One line above the tabs: the design's name, or what is wrong with the input. A pane whose
+    text changes in place (no re-layout)."""
+
     def render(errors, design):
         if errors:
             fields = ", ".join(state.param[n].label for n in errors if n in state.param)
-            return pn.pane.Alert(
-                f"Some inputs are not valid ({fields}): see the messages beside them. The plots "
-                "show the last valid design.", alert_type="warning", sizing_mode="stretch_width",
-                css_classes=["input-errors"],
+            return (
+                '<div class="input-errors" style="background:#fff3cd;border:1px solid #ffe69c;'
+                'padding:8px 12px;border-radius:6px;color:#664d03">'
+                f"Some inputs are not valid ({fields}): see the messages beside them. "
+                "The plots show the last valid design.</div>"
             )
         effects = ", ".join(design.effect_parameters) if design.effects else ""
-        text = f"**{design.name or 'Custom design'}**, {design.mode}" + (f"; effects: {effects}" if effects else "")
-        return pn.pane.Markdown(text, sizing_mode="stretch_width", margin=(0, 10))
+        name = design.name or "Custom design"
+        return f"<b>{name}</b>, {design.mode}" + (f"; effects: {effects}" if effects else "")
 
-    return pn.panel(pn.bind(render, state.param.errors, state.param.design), sizing_mode="stretch_width")
+    return pn.pane.HTML(pn.bind(render, state.param.errors, state.param.design),
+                        sizing_mode="stretch_width", margin=(4, 10))
 
 
 URL_NAMES = {
@@ -579,11 +597,3 @@ URL_NAMES = {
     "freq_min": "fmin_Hz",
     "freq_max": "fmax_Hz",
 }
-
-
-def presets_text():
-    return ", ".join(PRESETS)
-
-
-def design_summary_json(state):  # used by tests and the About tab
-    return json.dumps(state.design.to_dict(), indent=2)

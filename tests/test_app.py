@@ -5,7 +5,6 @@ import csv
 import io
 import logging
 
-import holoviews as hv
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
@@ -20,18 +19,14 @@ def app():
     return App()
 
 
-def curves(overlay):
-    """Every Curve in a (nested) overlay, by label."""
-    out = {}
-    for el in overlay.traverse(lambda e: e, [hv.Curve]):
-        out.setdefault(el.label, []).append(el)
-    return out
+def data(fig, key):
+    """What a figure's glyph holds (x, y)."""
+    d = fig.sources[key].data
+    return np.asarray(d["x"]), np.asarray(d["y"])
 
 
-def operating(app, quantity, axis):
-    overlay = app.plots.panels[(quantity, axis)][()]
-    label = next(lbl for lbl in curves(overlay) if lbl.startswith("at "))
-    return curves(overlay)[label][0]
+def figure(app, quantity, axis):
+    return app.plots.figures[(quantity, axis)]
 
 
 def test_factory_builds_a_fresh_session_each_time():
@@ -49,24 +44,28 @@ def test_defaults_are_the_paper_b_bushing(app):
 
 def test_frequency_plot_holds_the_core_stiffness(app):
     s = app.state
-    c = operating(app, "magnitude", "frequency")
-    f = c.dimension_values("frequency_hz")
+    f, k = data(figure(app, "magnitude", "frequency"), "operating")
     ref = stiffness(PAPER_B, f, s.amplitude * 1e-3)
-    assert_allclose(c.dimension_values("magnitude"), ref.magnitude[0] / 1e6, rtol=1e-12)
-    eta = operating(app, "loss_factor", "frequency")
-    assert_allclose(eta.dimension_values("loss_factor"), ref.loss_factor[0], rtol=1e-12)
-    assert c.kdims[0].unit == "Hz" and c.vdims[0].unit == "kN/mm"
+    assert_allclose(k, ref.magnitude[0] / 1e6, rtol=1e-12)
+    _, eta = data(figure(app, "loss_factor", "frequency"), "operating")
+    assert_allclose(eta, ref.loss_factor[0], rtol=1e-12)
+    fig = figure(app, "magnitude", "frequency").fig
+    assert fig.xaxis[0].axis_label == "Frequency (Hz)" and fig.yaxis[0].axis_label == "|K| (kN/mm)"
+    sweeps = figure(app, "magnitude", "frequency").sources["sweeps"].data
+    amps = s.sweep_amplitudes()
+    for ys, x in zip(sweeps["ys"], amps):
+        assert_allclose(ys, stiffness(PAPER_B, f, x * 1e-3).magnitude[0] / 1e6, rtol=1e-12)
 
 
 def test_amplitude_plot_holds_the_core_stiffness_in_torsion(app):
     s = app.state
     s.preset = "Table 1 bushing (torsion)"
     assert s.design == TABLE_1
-    c = operating(app, "magnitude", "amplitude")
-    x = c.dimension_values("amplitude")
+    x, k = data(figure(app, "magnitude", "amplitude"), "operating")
     ref = stiffness(TABLE_1, s.frequency_hz, x)
-    assert_allclose(c.dimension_values("magnitude"), ref.magnitude[:, 0], rtol=1e-12)
-    assert c.kdims[0].unit == "rad" and c.vdims[0].unit == "N·m/rad"
+    assert_allclose(k, ref.magnitude[:, 0], rtol=1e-12)
+    fig = figure(app, "magnitude", "amplitude").fig
+    assert fig.xaxis[0].axis_label == "Amplitude (rad)" and fig.yaxis[0].axis_label == "|K| (N·m/rad)"
     # the amplitude axis spans the Fletcher–Gent range: ε̂/ε½ from 1e-3 to 1e2
     from core import strain_factor
 
@@ -77,18 +76,20 @@ def test_amplitude_plot_holds_the_core_stiffness_in_torsion(app):
 def test_loop_holds_the_core_loop_and_its_branches(app):
     s = app.state
     s.amplitude, s.frequency_hz = 0.5, 3.0
-    overlay = app.plots.loop[()]
-    total = [c for c in overlay.traverse(lambda e: e, [hv.Curve]) if c.label == "total"][0]
     ref = loop(PAPER_B, 3.0, 0.5e-3, 200)
-    assert_allclose(total.dimension_values("displacement")[:-1], ref.displacement * 1e3, atol=1e-12)
-    assert_allclose(total.dimension_values("force")[:-1], ref.force, rtol=1e-12, atol=1e-9)
-    assert total.dimension_values("force")[0] == total.dimension_values("force")[-1]  # closed
+    x, force = data(app.plots.loop, "total")
+    assert_allclose(x[:-1], ref.displacement * 1e3, atol=1e-12)
+    assert_allclose(force[:-1], ref.force, rtol=1e-12, atol=1e-9)
+    assert force[0] == force[-1]  # closed
+    for name in ("elastic", "viscoelastic", "friction"):
+        assert_allclose(data(app.plots.loop, name)[1][:-1], getattr(ref, f"force_{name}"), rtol=1e-12, atol=1e-9)
+    assert "0.5 mm, 3 Hz" in app.plots.summary.object
 
 
 def test_moving_a_widget_changes_the_plots(app):
-    before = operating(app, "magnitude", "frequency").dimension_values("magnitude")
+    before = data(figure(app, "magnitude", "frequency"), "operating")[1]
     app.inputs.widgets["shear_modulus_mpa"].value = 3.0
-    after = operating(app, "magnitude", "frequency").dimension_values("magnitude")
+    after = data(figure(app, "magnitude", "frequency"), "operating")[1]
     assert app.state.design.material.shear_modulus == pytest.approx(3.0e6)
     assert np.all(after > before)
 
@@ -102,26 +103,28 @@ def test_log_slider_sets_the_amplitude_and_follows_it(app):
 
 
 def test_tap_moves_the_operating_point_in_every_plot(app):
-    tap_f = app.plots.taps[0]  # (magnitude, frequency)
-    tap_f.event(x=42.0, y=4.0)
+    app.plots._tap_frequency(42.0)
     assert app.state.frequency_hz == pytest.approx(42.0)
     for quantity in ("magnitude", "loss_factor"):
-        overlay = app.plots.panels[(quantity, "frequency")][()]
-        vline = overlay.traverse(lambda e: e, [hv.VLine])[0]
-        assert vline.data == pytest.approx(42.0)
-        assert any(lbl == "at 42 Hz" for lbl in curves(app.plots.panels[(quantity, "amplitude")][()]))
-    tap_a = next(t for t, key in zip(app.plots.taps, app.plots.panels) if key == ("loss_factor", "amplitude"))
-    tap_a.event(x=0.03, y=0.1)
+        assert figure(app, quantity, "frequency").marker.location == pytest.approx(42.0)
+        x, k = data(figure(app, quantity, "amplitude"), "operating")
+        ref = stiffness(PAPER_B, 42.0, x * 1e-3)
+        expected = ref.magnitude[:, 0] / 1e6 if quantity == "magnitude" else ref.loss_factor[:, 0]
+        assert_allclose(k, expected, rtol=1e-12)
+    app.plots._tap_amplitude(0.03)
     assert app.state.amplitude == pytest.approx(0.03)
-    assert "0.03" in app.plots.loop[()].traverse(lambda e: e, [hv.Curve])[-1].opts.get().kwargs["title"]
+    assert figure(app, "magnitude", "amplitude").marker.location == pytest.approx(0.03)
+    assert "0.03 mm, 42 Hz" in app.plots.summary.object
+    app.plots._tap_amplitude(-1.0)  # outside: ignored
+    assert app.state.amplitude == pytest.approx(0.03)
 
 
 def test_invalid_input_keeps_the_last_good_design_and_says_why(app):
-    good = operating(app, "magnitude", "frequency").dimension_values("magnitude")
+    good = data(figure(app, "magnitude", "frequency"), "operating")[1]
     app.state.outer_radius_mm = 15.0  # below a = 20 mm
     assert app.state.errors == {"outer_radius_mm": "Must be larger than the inner radius a."}
     assert app.state.design == PAPER_B
-    assert_allclose(operating(app, "magnitude", "frequency").dimension_values("magnitude"), good)
+    assert_allclose(data(figure(app, "magnitude", "frequency"), "operating")[1], good)
     app.state.fractional_order = 1.4
     app.state.length_mm = None
     assert set(app.state.errors) == {"outer_radius_mm", "fractional_order", "length_mm"}
@@ -132,7 +135,7 @@ def test_invalid_input_keeps_the_last_good_design_and_says_why(app):
 def test_sweep_range_errors(app):
     app.state.freq_max = 0.5
     assert "freq_max" in app.state.errors
-    f = operating(app, "magnitude", "frequency").dimension_values("frequency_hz")
+    f = data(figure(app, "magnitude", "frequency"), "operating")[0]
     assert f.min() > 0 and f.max() > f.min()
 
 
@@ -163,7 +166,10 @@ def test_slices_view_holds_the_core_numbers(app):
     k1 = stiffness(PAPER_B, app.state.frequency_hz, x).magnitude[:, 0]
     k3 = stiffness(PAPER_B, app.state.frequency_hz, x, slices=3).magnitude[:, 0]
     assert_allclose(data["magnitude_diff_pct"][3], 100 * (k3 / k1 - 1), rtol=1e-9)
-    assert "3 slices" in app.slices.summary(app.state.design, 10.0, 0.1)
+    assert "3 slices" in app.slices.summary(data)
+    app.tabs.active = 1  # shown: its figures hold the same numbers
+    x, k = app.slices.figures["magnitude"].sources["3"].data["x"], app.slices.figures["magnitude"].sources["3"].data["y"]
+    assert_allclose(k, stiffness(PAPER_B, app.state.frequency_hz, np.asarray(x) * 1e-3, slices=3).magnitude[:, 0] / 1e6, rtol=1e-12)
 
 
 def test_teaching_branches_add_up_to_the_stiffness(app):
@@ -173,8 +179,13 @@ def test_teaching_branches_add_up_to_the_stiffness(app):
     assert_allclose(sum(d["real"].values()), ref.stiffness.real[:, 0] / 1e6, rtol=1e-12)
     assert_allclose(sum(d["loss"].values()), ref.loss_factor[:, 0], rtol=1e-12)
     assert np.all(d["loss"]["elastic"] == 0)
-    frame = app.teaching._loop_frame(5, app.state.design, 10.0, {})
-    assert set(frame.keys()) == {"total", "elastic", "viscoelastic", "friction"}
+    app.tabs.active = 2
+    band = app.teaching.figures["real"].sources["friction"].data
+    assert_allclose(np.asarray(band["y2"]), sum(d["real"].values()), rtol=1e-12)
+    app.teaching.player.value = 3
+    x = np.geomspace(*app.state.amplitude_bounds, app.teaching.FRAMES)[3]
+    assert f"{x:.3g} mm" in app.teaching.frame_label.object
+    assert np.max(np.abs(app.teaching.loop.sources["total"].data["y"])) == pytest.approx(1.0)
 
 
 def test_comparison_with_a_pinned_reference(app):
@@ -186,12 +197,12 @@ def test_comparison_with_a_pinned_reference(app):
     assert c["operating"]["magnitude"][2] == pytest.approx(10.0, rel=1e-9)
     assert c["operating"]["loss_factor"][2] == pytest.approx(0.0, abs=1e-9)
     assert c["largest_over_frequency"]["magnitude"] == pytest.approx(10.0, rel=1e-9)
-    overlay = app.plots.panels[("magnitude", "frequency")][()]
-    ref = curves(overlay)["reference"][0]
-    assert_allclose(ref.dimension_values("magnitude") * 1.1, operating(app, "magnitude", "frequency").dimension_values("magnitude"), rtol=1e-12)
+    ref = data(figure(app, "magnitude", "frequency"), "reference")[1]
+    assert_allclose(ref * 1.1, data(figure(app, "magnitude", "frequency"), "operating")[1], rtol=1e-12)
     assert "+10.00 %" in app.compare.table(s.reference, s.design, s.frequency_hz, s.amplitude, s.errors)
     s.clear_reference()
     assert s.comparison() is None
+    assert len(data(figure(app, "magnitude", "frequency"), "reference")[0]) == 0
 
 
 def test_exports_are_the_public_formats(app):
@@ -205,15 +216,23 @@ def test_exports_are_the_public_formats(app):
     assert_allclose(data[data[:, 1] == data[0, 1], 4], ref.magnitude[0, data[:, 1] == data[0, 1]], rtol=1e-10)
 
 
-def test_plot_callbacks_keep_the_last_plot_and_log_one_line(app, caplog):
-    good = app.plots._operating_curve("magnitude", "frequency", app.state.design, 1, 100, {}, 10.0, 0.1)
+def test_a_failing_refresh_keeps_the_last_plots_and_logs_one_line(app, caplog):
+    good = data(figure(app, "magnitude", "frequency"), "operating")[1]
     original = app.state.frequency_sweep
     app.state.frequency_sweep = lambda *a, **k: 1 / 0
     try:
         with caplog.at_level(logging.WARNING, logger="bushing.app"):
-            kept = app.plots._operating_curve("magnitude", "frequency", app.state.design, 1, 100, {}, 10.0, 0.1)
+            app.state.shear_modulus_mpa = 3.0
     finally:
         app.state.frequency_sweep = original
-    assert kept is good
+    assert_allclose(data(figure(app, "magnitude", "frequency"), "operating")[1], good)
     assert len(caplog.records) == 1 and caplog.records[0].exc_info is None
     assert "ZeroDivisionError" in caplog.records[0].getMessage()
+
+
+def test_hidden_tabs_catch_up_when_shown(app):
+    app.state.shear_modulus_mpa = 3.0  # the Slices tab is hidden: not refreshed yet
+    stale = np.asarray(app.slices.figures["magnitude"].sources["1"].data["y"]).copy()
+    app.tabs.active = 1
+    fresh = np.asarray(app.slices.figures["magnitude"].sources["1"].data["y"])
+    assert np.all(fresh > stale)

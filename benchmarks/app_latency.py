@@ -1,0 +1,183 @@
+"""Explorer latency in real Chromium (issue 3): prints figures, asserts nothing.
+
+    python benchmarks/app_latency.py [--changes 40] [--sessions 10]
+
+Starts `bushing serve` on a free port, opens the explorer in the system Chromium and measures:
+
+* first page load: from navigation to every plot drawn and the document idle;
+* one session: from a widget change (set on its Bokeh model, exactly as a user's edit reaches
+  the server) to the last plot update painted (the last document change, then an animation
+  frame), over many changes of the shear modulus and the drive amplitude;
+* N sessions at once: N pages changing a widget at the same moment, round after round with a
+  person's pause (0.5 s) between rounds; and, for reference, N pages changing back to back
+  (each as soon as its last change is drawn), which saturates the machine.
+
+All N pages run in one Chromium on this same 2-core machine as the server, so the pages'
+rendering competes with the server for the CPU; users on their own machines would not.
+
+Targets: median ≤ 150 ms and p95 ≤ 300 ms with one session; p95 ≤ 500 ms with 10 sessions;
+first load ≤ 3 s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import shutil
+import socket
+import statistics
+import subprocess
+import sys
+import time
+import urllib.request
+
+from playwright.async_api import async_playwright
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+# Ten users each look at their own page: background-tab throttling (timers, animation frames)
+# would measure Chromium's tab scheduling, not the explorer, so it is switched off.
+ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update",
+        "--disable-sync", "--no-first-run", "--disable-quic", "--disable-background-timer-throttling",
+        "--disable-renderer-backgrounding", "--disable-backgrounding-occluded-windows"]
+
+READY_JS = """() => window.Bokeh && Bokeh.documents.length > 0 && Bokeh.documents[0].is_idle &&
+  [...Bokeh.documents[0].all_models].filter(m => m.type === 'Figure').length >= 5"""
+
+# Change a widget's model and time until the last change to a plot (its data, ranges, marker,
+# legend or axes) has been painted; the URL and text panes updating later do not count.
+CHANGE_JS = """async ([title, value, quiet]) => {
+  const doc = Bokeh.documents[0];
+  const model = [...doc.all_models].find(m => m.title === title || m.label === title);
+  const PLOT = new Set(['ColumnDataSource', 'DataRange1d', 'Span', 'LegendItem', 'Legend', 'LinearAxis',
+                        'LogAxis', 'Title', 'Figure']);
+  let lastPaint = null, lastChange = null;
+  const cb = (ev) => {
+    if (!ev.model || !PLOT.has(ev.model.type)) return;
+    lastChange = performance.now();
+    requestAnimationFrame(() => { lastPaint = performance.now(); });
+  };
+  const t0 = performance.now();
+  model.value = value;
+  doc.on_change(cb);
+  const ok = await new Promise(resolve => {
+    const tick = () => {
+      if (lastChange !== null && performance.now() - lastChange > quiet && lastPaint >= lastChange) resolve(true);
+      else if (performance.now() - t0 > 20000) resolve(false);
+      else setTimeout(tick, 10);
+    };
+    setTimeout(tick, 10);
+  });
+  doc.remove_on_change(cb);
+  return ok ? lastPaint - t0 : null;
+}"""
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def start_server(port):
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "core.cli", "serve", "--port", str(port)],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )
+    deadline = time.time() + 60
+    while time.time() < deadline:
+        try:
+            with urllib.request.urlopen(f"http://localhost:{port}/liveness", timeout=2):
+                return proc
+        except OSError:
+            time.sleep(0.2)
+    proc.kill()
+    raise RuntimeError("the explorer did not start")
+
+
+_RUN = iter(range(1, 10**6))
+
+
+def changes(n):
+    """Alternate a material change (every plot recomputed) and an operating-point change, with
+    values never used before (a repeated value changes nothing)."""
+    run = next(_RUN)
+    out = []
+    for i in range(n):
+        if i % 2 == 0:
+            out.append(("Shear modulus µ (MPa)", round(2.0 + 0.0001 * run + 0.013 * i, 6)))
+        else:  # log10 of the amplitude in mm
+            out.append(("Drive amplitude (mm)", round(-1.5 + 0.0001 * run + 0.02 * i, 6)))
+    return out
+
+
+async def open_page(browser, url):
+    page = await browser.new_page(viewport={"width": 1500, "height": 1300})
+    t0 = time.perf_counter()
+    await page.goto(url)
+    await page.wait_for_function(READY_JS, timeout=60000, polling=20)
+    return page, time.perf_counter() - t0
+
+
+async def run_changes(page, n, quiet=150):
+    out = []
+    for title, value in changes(n):
+        ms = await page.evaluate(CHANGE_JS, [title, value, quiet])
+        if ms is None:
+            raise RuntimeError(f"no plot updated within 20 s after setting {title} = {value}")
+        out.append(ms)
+    return out
+
+
+def pct(values, q):
+    values = sorted(values)
+    return values[min(len(values) - 1, round(q / 100 * (len(values) - 1)))]
+
+
+def report(name, ms, target):
+    print(f"{name:<34} n={len(ms):>3}  median {statistics.median(ms):6.0f} ms   p95 {pct(ms, 95):6.0f} ms"
+          f"   max {max(ms):6.0f} ms   ({target})")
+
+
+async def main(n_changes, n_sessions):
+    port = free_port()
+    server = start_server(port)
+    url = f"http://localhost:{port}/"
+    try:
+        async with async_playwright() as p:
+            browser = await p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+            loads = []
+            for _ in range(3):
+                page, seconds = await open_page(browser, url)
+                loads.append(seconds)
+                await page.close()
+            print(f"{'first page load':<34} n={len(loads):>3}  median {statistics.median(loads):6.2f} s    "
+                  f"max {max(loads):.2f} s   (target ≤ 3 s)")
+            page, _ = await open_page(browser, url)
+            await run_changes(page, 4)  # warm-up
+            report("one session, widget → all plots", await run_changes(page, n_changes),
+                   "target median ≤ 150 ms, p95 ≤ 300 ms")
+            await page.close()
+            pages = [(await open_page(browser, url))[0] for _ in range(n_sessions)]
+            for pg in pages:
+                await run_changes(pg, 2)
+            # rounds: every session changes a widget at the same moment, then a person's pause
+            rounds = []
+            for _ in range(max(10, n_changes // 2)):
+                rounds += await asyncio.gather(*(run_changes(pg, 1) for pg in pages))
+                await asyncio.sleep(0.5)
+            report(f"{n_sessions} sessions, simultaneous rounds", [v for r in rounds for v in r], "target p95 ≤ 500 ms")
+            # back to back: each session changes again as soon as its plots are drawn (saturation)
+            results = await asyncio.gather(*(run_changes(pg, max(10, n_changes // 2)) for pg in pages))
+            report(f"{n_sessions} sessions, back to back", [v for r in results for v in r], "saturation, for reference")
+            await browser.close()
+    finally:
+        server.terminate()
+        server.wait(10)
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--changes", type=int, default=40)
+    ap.add_argument("--sessions", type=int, default=10)
+    a = ap.parse_args()
+    asyncio.run(main(a.changes, a.sessions))
