@@ -152,3 +152,48 @@ def test_installed_entry_point_runs_without_traceback(designs, tmp_path):
         capture_output=True, text=True, check=False,
     )
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "Traceback" not in bad.stderr
+
+
+def _free_port():
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_serve_prints_its_url_and_answers():
+    import time
+    import urllib.request
+
+    port = _free_port()
+    proc = subprocess.Popen([sys.executable, "-m", "core.cli", "serve", "--port", str(port)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        line = proc.stdout.readline()
+        assert line.strip() == f"Bushing Explorer: http://localhost:{port}/"
+        deadline = time.time() + 30
+        while True:
+            try:
+                with urllib.request.urlopen(f"http://localhost:{port}/", timeout=5) as r:
+                    assert r.status == 200 and b"Bushing Explorer" in r.read()
+                    break
+            except OSError:
+                assert time.time() < deadline
+                time.sleep(0.3)
+    finally:
+        proc.terminate()
+        proc.wait(10)
+
+
+def test_serve_refuses_a_busy_or_impossible_port(capsys):
+    import socket
+
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        status, _, err = run(["serve", "--port", port, "--address", "127.0.0.1"], capsys)
+    assert status == 2 and err.count("\n") == 1 and "cannot listen" in err
+    status, _, err = run(["serve", "--port", 70000], capsys)
+    assert status == 2 and "65535" in err
