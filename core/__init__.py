@@ -12,6 +12,7 @@ from .bushing import (
     loop,
     shape_factor,
     stiffness,
+    stiffness_points,
     strain_factor,
 )
 from .design import (
@@ -48,6 +49,7 @@ __all__ = [
     "read_design",
     "shape_factor",
     "stiffness",
+    "stiffness_points",
     "strain_factor",
     "write_design",
 ]

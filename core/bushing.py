@@ -168,10 +168,17 @@ def _check_slices(slices) -> int | str:
     return int(slices)
 
 
-@functools.lru_cache(maxsize=128)
-def _stiffness_cached(design: Design, freq: tuple, amp: tuple, slices, route) -> StiffnessResult:
-    f = np.array(freq)
-    x = np.array(amp)
+def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | str = 1,
+                     route: Route = "analytic") -> np.ndarray:
+    """Complex stiffness at paired points (frequency_hz[i], amplitude[i]), broadcast together:
+    for measured data, which is no grid. Same model and options as :func:`stiffness`; no cache.
+    """
+    f, x = np.broadcast_arrays(np.asarray(frequency_hz, float), np.asarray(amplitude, float))
+    shape = f.shape
+    f, x = f.ravel(), x.ravel()
+    slices = _check_slices(slices)
+    if route not in ROUTES:
+        raise ValueError(f"route: must be one of {', '.join(ROUTES)}, got {route!r}")
     geo, mode = design.geometry, design.mode
     effects = design.effect_parameters
     modulus = modulus_function(design, route)
@@ -184,26 +191,28 @@ def _stiffness_cached(design: Design, freq: tuple, amp: tuple, slices, route) ->
                 "effects.wave_effects: standing waves are computed for the single equivalent "
                 "modulus; they cannot be combined with slices, the continuum or nonuniform_strain"
             )
-        k = wave_stiffness(
-            mode, geo.inner_radius, geo.outer_radius, geo.length,
-            modulus(f[None, :], c * x[:, None]), f[None, :], effects["wave_effects"]["density"],
-        )
+        k = wave_stiffness(mode, geo.inner_radius, geo.outer_radius, geo.length,
+                           modulus(f, c * x), f, effects["wave_effects"]["density"])
     elif slices == 1:
-        k = shape_factor(geo, mode) * modulus(f[None, :], c * x[:, None])  # eqs 16–18
+        k = shape_factor(geo, mode) * modulus(f, c * x)  # eqs 16–18
     else:
         nodes = continuum_nodes(geo, mode) if slices == "continuum" else slice_nodes(geo, mode, slices)
-        ff, xx = np.meshgrid(f, x)  # (A, F)
-        k = solve_series(
-            nodes,
-            drive=xx.ravel(),
-            modulus=lambda eps: modulus(ff.ravel()[:, None], eps),
-            strain_guess=c * xx.ravel(),
-        ).reshape(xx.shape)
+        k = solve_series(nodes, drive=x, modulus=lambda eps: modulus(f[:, None], eps), strain_guess=c * x)
     if "inertia" in effects:
-        k = inertia_correction(k, f[None, :], effects["inertia"]["mass"])
+        k = inertia_correction(k, f, effects["inertia"]["mass"])
     if not np.all(np.isfinite(k)):
-        raise ValueError("the stiffness is not finite on this grid (check the design's effects)")
-    return StiffnessResult(design, _readonly(f), _readonly(x), _readonly(k), slices, route)
+        raise ValueError("the stiffness is not finite at these points (check the design's effects)")
+    return k.reshape(shape)
+
+
+@functools.lru_cache(maxsize=128)
+def _stiffness_cached(design: Design, freq: tuple, amp: tuple, slices, route) -> StiffnessResult:
+    f = np.array(freq)
+    x = np.array(amp)
+    if "nonuniform_strain" in design.effect_parameters and slices == 1:
+        slices = "continuum"
+    k = stiffness_points(design, f[None, :], x[:, None], slices=slices, route=route)
+    return StiffnessResult(design, _readonly(f), _readonly(x), _readonly(np.array(k)), slices, route)
 
 
 def stiffness(
@@ -345,33 +354,41 @@ def loop(
     xa = float(_grid("amplitude", amplitude)[0])
     if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 4:
         raise ValueError(f"points: must be a whole number ≥ 4, got {points!r}")
-    m = design.material
-    effects = design.effect_parameters
     _refuse_structural_effects(design, "the branch-by-branch hysteresis loop")
-    c = strain_factor(design.geometry, design.mode)
-    scale = shape_factor(design.geometry, design.mode) / (2.0 * c)  # F = S σ / (2c)
-    eps_amp = c * xa
     theta = 2.0 * np.pi * np.arange(points) / points
     if route == "analytic":
-        eps = eps_amp * np.sin(theta)
-        el = 2.0 * m.shear_modulus * eps
-        if "strain_stiffening" in effects:
-            el = el * (1.0 + effects["strain_stiffening"]["stiffening"] * eps**2)
-        visco_amp = m.fractional_coefficient * (2j * np.pi * f) ** m.fractional_order
-        visco_amp += 2j * np.pi * f * effects.get("viscous", {}).get("viscosity", 0.0)
-        fr = np.imag(visco_amp * eps_amp * np.exp(1j * theta))
-        fric = steady_friction_loop(eps_amp, theta, m.friction_stress_max, m.friction_strain_half)
-        if "rate_amplitude_coupling" in effects:
-            fric = fric * (f / REFERENCE_FREQUENCY_HZ) ** effects["rate_amplitude_coupling"][
-                "rate_exponent"
-            ]
+        forces = loop_force(design, f, xa, theta)
     elif route == "time-domain":
-        el, fr, fric = _time_domain_loop(m, effects, f, eps_amp, points)
+        c = strain_factor(design.geometry, design.mode)
+        scale = shape_factor(design.geometry, design.mode) / (2.0 * c)  # F = S σ / (2c)
+        stresses = _time_domain_loop(design.material, design.effect_parameters, f, c * xa, points)
+        forces = tuple(scale * part for part in stresses)
     else:
         raise ValueError(f"route: must be one of {', '.join(ROUTES)}, got {route!r}")
-    return LoopResult(
-        design, f, xa, theta, xa * np.sin(theta), scale * el, scale * fr, scale * fric
-    )
+    return LoopResult(design, f, xa, theta, xa * np.sin(theta), *forces)
+
+
+def loop_force(design: Design, frequency_hz: float, amplitude: float, phase):
+    """Steady force (moment) branches at the drive phases θ, x = x̂ sin θ, in closed form:
+    (elastic, viscoelastic, friction), each in N or N·m. Elastic 2µε(1 + βε²); viscoelastic
+    Im((m(iω)^α + iωc) ε̂ e^{iθ}); friction the steady Berg loop (× (f/10 Hz)^γ)."""
+    m = design.material
+    effects = design.effect_parameters
+    c = strain_factor(design.geometry, design.mode)
+    scale = shape_factor(design.geometry, design.mode) / (2.0 * c)  # F = S σ / (2c)
+    eps_amp = c * amplitude
+    theta = np.asarray(phase, dtype=float)
+    eps = eps_amp * np.sin(theta)
+    el = 2.0 * m.shear_modulus * eps
+    if "strain_stiffening" in effects:
+        el = el * (1.0 + effects["strain_stiffening"]["stiffening"] * eps**2)
+    visco_amp = m.fractional_coefficient * (2j * np.pi * frequency_hz) ** m.fractional_order
+    visco_amp += 2j * np.pi * frequency_hz * effects.get("viscous", {}).get("viscosity", 0.0)
+    fr = np.imag(visco_amp * eps_amp * np.exp(1j * theta))
+    fric = steady_friction_loop(eps_amp, theta, m.friction_stress_max, m.friction_strain_half)
+    if "rate_amplitude_coupling" in effects:
+        fric = fric * (frequency_hz / REFERENCE_FREQUENCY_HZ) ** effects["rate_amplitude_coupling"]["rate_exponent"]
+    return scale * el, scale * fr, scale * fric
 
 
 def _refuse_structural_effects(design: Design, what: str, allowed=()):

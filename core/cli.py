@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import csv
 import io
+import json
 import math
 import sys
 from contextlib import contextmanager
@@ -16,6 +17,7 @@ from contextlib import contextmanager
 import numpy as np
 
 from .bushing import loop, stiffness
+from .data import DataError
 from .design import DesignError, read_design
 from .material import ConvergenceError
 
@@ -124,6 +126,20 @@ def build_parser() -> argparse.ArgumentParser:
         "--points", type=_count("--points", 4), default=256, metavar="N", help="default 256"
     )
     lp.add_argument("-o", dest="output", metavar="OUT.csv", help="write here, not to stdout")
+    ft = sub.add_parser(
+        "fit",
+        help="identify the five material parameters from measured data",
+        description="Fit µ, m, α, σ_fmax and ε½ to measured dynamic stiffness (and a measured "
+        "loop) from several starting points; the design's material is the first. Writes the "
+        "design file with the fitted material and a `fit` object: standard_errors, "
+        "correlation, gap.",
+    )
+    ft.add_argument("measured", metavar="MEASURED.csv", help="measured stiffness (FORMATS.md)")
+    ft.add_argument("--design", required=True, metavar="DESIGN.json",
+                    help="geometry, mode and starting material")
+    ft.add_argument("--loop", metavar="LOOP.csv", help="a measured steady loop (time_s, displacement, force)")
+    ft.add_argument("-o", dest="output", metavar="FITTED.json", help="write here, not to stdout")
+
     sv = sub.add_parser(
         "serve",
         help="start the explorer in the browser (embedded defaults, no setup)",
@@ -191,7 +207,7 @@ def _one_line_errors():
         yield
     except InputError as exc:
         _fail(str(exc), 2)
-    except (DesignError, ValueError) as exc:
+    except (DesignError, DataError, ValueError) as exc:
         _fail(f"bushing: {exc}", 2)
     except ConvergenceError as exc:
         _fail(f"bushing: {exc}", 1)
@@ -206,6 +222,25 @@ def _fail(message: str, status: int):
     raise SystemExit(status)
 
 
+def _cmd_fit(args) -> None:
+    from .data import read_loop, read_stiffness
+    from .fit import fit_global
+
+    design = read_design(args.design)
+    data = read_stiffness(args.measured)
+    loop_data = read_loop(args.loop) if args.loop else None
+    result = fit_global(design, data, loop_data)
+    text = json.dumps(result.to_dict(), indent=2) + "\n"
+    if args.output is None:
+        sys.stdout.write(text)
+        return
+    try:
+        with open(args.output, "w", encoding="utf-8") as fh:
+            fh.write(text)
+    except OSError as exc:
+        raise InputError(f"bushing: cannot write {args.output!r}: {exc.strerror}")
+
+
 def _cmd_serve(args) -> None:
     if args.port > 65535:
         raise InputError(f"bushing serve: --port must be at most 65535, got {args.port}")
@@ -217,7 +252,7 @@ def _cmd_serve(args) -> None:
         raise InputError(f"bushing serve: cannot listen on {args.address}:{args.port}: {exc.strerror}")
 
 
-COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop, "serve": _cmd_serve}
+COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop, "fit": _cmd_fit, "serve": _cmd_serve}
 
 
 def main(argv: list[str] | None = None) -> int:

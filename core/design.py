@@ -168,7 +168,7 @@ class Design:
 
 _GEOMETRY_KEYS = tuple(f.name for f in fields(Geometry))
 _MATERIAL_KEYS = tuple(f.name for f in fields(Material))
-_TOP_KEYS = ("name", "mode", "geometry", "material", "effects")
+_TOP_KEYS = ("name", "mode", "geometry", "material", "effects", "fit")
 
 
 def as_dict(value) -> dict[str, float]:
@@ -194,6 +194,8 @@ def design_from_dict(data: Any) -> Design:
     _exact_keys("", data, _TOP_KEYS, ("mode", "geometry", "material"))
     _exact_keys("geometry", data["geometry"], _GEOMETRY_KEYS, _GEOMETRY_KEYS)
     _exact_keys("material", data["material"], _MATERIAL_KEYS, _MATERIAL_KEYS)
+    if "fit" in data and not isinstance(data["fit"], Mapping):  # a fitted file's report: kept aside
+        raise DesignError("fit", "must be an object (the report of `bushing fit`)")
     if not isinstance(data["mode"], str):
         raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {data['mode']!r}")
     return Design(

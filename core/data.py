@@ -1,0 +1,247 @@
+"""Measured data (FORMATS.md): dynamic-stiffness tables and hysteresis loops, read strictly.
+
+Every refusal names the line (the header is line 1) and the reason; no row is ever dropped
+silently. All numbers are SI: Hz, m or rad, N/m or N·m/rad, s, N or N·m.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+MAX_BYTES = 20 * 1024 * 1024
+MAX_ROWS = 200_000
+
+STIFFNESS_KEYS = ("frequency_hz", "amplitude")
+STIFFNESS_PAIRS = (("magnitude", "loss_factor"), ("stiffness_real", "stiffness_imag"))
+LOOP_COLUMNS = ("time_s", "displacement", "force")
+
+
+class DataError(ValueError):
+    """A measured-data file breaks a rule; the message names the line and the reason."""
+
+
+@dataclass(frozen=True, eq=False)
+class MeasuredStiffness:
+    """Measured complex dynamic stiffness, one entry per (frequency, amplitude) point."""
+
+    frequency_hz: np.ndarray
+    amplitude: np.ndarray
+    stiffness: np.ndarray  # complex
+
+    @property
+    def magnitude(self) -> np.ndarray:
+        return np.abs(self.stiffness)
+
+    @property
+    def loss_factor(self) -> np.ndarray:
+        return self.stiffness.imag / self.stiffness.real
+
+    def __len__(self):
+        return self.frequency_hz.size
+
+    def select(self, mask) -> MeasuredStiffness:
+        mask = np.asarray(mask)
+        return MeasuredStiffness(self.frequency_hz[mask], self.amplitude[mask], self.stiffness[mask])
+
+    def to_csv(self, path: str | Path | None = None, polar: bool = True) -> str:
+        cols = {"frequency_hz": self.frequency_hz, "amplitude": self.amplitude}
+        if polar:
+            cols.update(magnitude=self.magnitude, loss_factor=self.loss_factor)
+        else:
+            cols.update(stiffness_real=self.stiffness.real, stiffness_imag=self.stiffness.imag)
+        text = pd.DataFrame(cols).to_csv(index=False, float_format="%.10g", lineterminator="\n")
+        if path is not None:
+            Path(path).write_text(text, encoding="utf-8")
+        return text
+
+
+@dataclass(frozen=True, eq=False)
+class MeasuredLoop:
+    """A measured steady harmonic test: displacement (m or rad) and force (N or N·m) in time."""
+
+    time_s: np.ndarray
+    displacement: np.ndarray
+    force: np.ndarray
+
+    def harmonic(self):
+        """Frequency (Hz), peak amplitude and the phase θ(t) of the drive x ≈ x̂ sin θ, from a
+        least-squares sine fit (frequency refined around the spectral peak)."""
+        t, x = self.time_s, self.displacement - np.mean(self.displacement)
+        dt = np.median(np.diff(t))
+        spec = np.abs(np.fft.rfft(x * np.hanning(x.size)))
+        freqs = np.fft.rfftfreq(x.size, dt)
+        f0 = freqs[1 + int(np.argmax(spec[1:]))]
+
+        def fit(f):
+            basis = np.column_stack([np.sin(2 * np.pi * f * t), np.cos(2 * np.pi * f * t), np.ones_like(t)])
+            coef, *_ = np.linalg.lstsq(basis, self.displacement, rcond=None)
+            return coef, float(np.sum((basis @ coef - self.displacement) ** 2))
+
+        from scipy.optimize import minimize_scalar
+
+        span = max(freqs[1], 1e-12)
+        best = minimize_scalar(lambda f: fit(f)[1], bounds=(f0 - span, f0 + span), method="bounded",
+                               options={"xatol": span * 1e-9})
+        f = float(best.x)
+        (a, b, _), _ = fit(f)
+        amp = math.hypot(a, b)
+        phase0 = math.atan2(b, a)  # x = amp sin(ωt + phase0)
+        return f, amp, 2 * np.pi * f * t + phase0
+
+
+def _file_text(path, what: str) -> str:
+    path = Path(path)
+    try:
+        size = path.stat().st_size
+    except OSError as exc:
+        raise DataError(f"cannot read {what} file {str(path)!r}: {exc.strerror}") from None
+    if size > MAX_BYTES:
+        raise DataError(f"{what} file is too large ({size} bytes; at most {MAX_BYTES})")
+    try:
+        return path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise DataError(f"{what} file {str(path)!r} is not UTF-8 text") from None
+    except OSError as exc:
+        raise DataError(f"cannot read {what} file {str(path)!r}: {exc.strerror}") from None
+
+
+def _table(text: str | bytes, what: str) -> pd.DataFrame:
+    """A CSV as strings (nothing converted or dropped yet), refusing empty or oversized text."""
+    if isinstance(text, bytes):
+        if len(text) > MAX_BYTES:
+            raise DataError(f"{what} file is too large ({len(text)} bytes; at most {MAX_BYTES})")
+        try:
+            text = text.decode("utf-8")
+        except UnicodeDecodeError:
+            raise DataError(f"{what} file is not UTF-8 text") from None
+    if len(text) > MAX_BYTES:
+        raise DataError(f"{what} file is too large (at most {MAX_BYTES} bytes)")
+    if not text.strip():
+        raise DataError(f"{what} file is empty")
+    try:
+        with warnings.catch_warnings():
+            # pandas would drop a row's extra fields (or take them for an index): refuse instead
+            warnings.simplefilter("error", pd.errors.ParserWarning)
+            df = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False, skip_blank_lines=False,
+                             skipinitialspace=True, index_col=False)
+    except pd.errors.ParserWarning:
+        raise DataError(f"{what} file: {_longer_row(text)}") from None
+    except pd.errors.ParserError as exc:
+        raise DataError(f"{what} file is not a valid CSV table: {' '.join(str(exc).split())}") from None
+    except pd.errors.EmptyDataError:
+        raise DataError(f"{what} file is empty") from None
+    df.columns = [str(c).strip() for c in df.columns]
+    if len(df) > MAX_ROWS:
+        raise DataError(f"{what} file has too many rows ({len(df)}; at most {MAX_ROWS})")
+    return df
+
+
+def _longer_row(text: str) -> str:
+    rows = csv.reader(io.StringIO(text))
+    width = len(next(rows))
+    for line, row in enumerate(rows, start=2):
+        if len(row) > width:
+            return f"line {line} has {len(row)} fields, the header {width}"
+    return "a row has more fields than the header"
+
+
+def _rows(df: pd.DataFrame, what: str):
+    if len(df) == 0:
+        raise DataError(f"{what} file has a header but no data rows")
+
+
+def _numbers(df: pd.DataFrame, columns, what: str) -> dict[str, np.ndarray]:
+    """Convert columns to finite floats, refusing the first bad cell with its line number."""
+    out = {}
+    for col in columns:
+        values = np.empty(len(df))
+        for i, cell in enumerate(df[col].tolist()):
+            line = i + 2
+            text = str(cell).strip()
+            if text == "":
+                raise DataError(f"line {line}: {col} is missing")
+            try:
+                v = float(text)
+            except ValueError:
+                raise DataError(f"line {line}: {col} is not a number ({text!r})") from None
+            if not math.isfinite(v):
+                raise DataError(f"line {line}: {col} is not finite ({text!r})")
+            values[i] = v
+        out[col] = values
+    return out
+
+
+def _positive(values: dict, col: str):
+    bad = np.flatnonzero(values[col] <= 0)
+    if bad.size:
+        raise DataError(f"line {bad[0] + 2}: {col} must be positive, got {values[col][bad[0]]:g}")
+
+
+def read_stiffness(path) -> MeasuredStiffness:
+    """Read a measured-stiffness CSV file (see :func:`parse_stiffness`)."""
+    return parse_stiffness(_file_text(path, "stiffness"))
+
+
+def read_loop(path) -> MeasuredLoop:
+    """Read a measured-loop CSV file (see :func:`parse_loop`)."""
+    return parse_loop(_file_text(path, "loop"))
+
+
+def parse_stiffness(text: str | bytes) -> MeasuredStiffness:
+    """Parse a measured-stiffness CSV: columns frequency_hz, amplitude and either magnitude,
+    loss_factor or stiffness_real, stiffness_imag; one row per point."""
+    df = _table(text, "stiffness")
+    cols = set(df.columns)
+    pair = next((p for p in STIFFNESS_PAIRS if set(p) <= cols), None)
+    missing = [c for c in STIFFNESS_KEYS if c not in cols]
+    if missing or pair is None:
+        need = " and ".join(" + ".join(p) for p in STIFFNESS_PAIRS)
+        raise DataError(
+            f"line 1: the header must name frequency_hz, amplitude and either {need.replace(' and ', ' or ')}"
+            f" (found: {', '.join(df.columns)})"
+        )
+    extra = cols - set(STIFFNESS_KEYS) - set(pair)
+    if extra:
+        raise DataError(f"line 1: unknown column(s) {', '.join(sorted(extra))}")
+    _rows(df, "stiffness")
+    v = _numbers(df, (*STIFFNESS_KEYS, *pair), "stiffness")
+    _positive(v, "frequency_hz")
+    _positive(v, "amplitude")
+    if pair[0] == "magnitude":
+        _positive(v, "magnitude")
+        eta = v["loss_factor"]
+        k = v["magnitude"] * (1 + 1j * eta) / np.sqrt(1 + eta**2)
+    else:
+        k = v["stiffness_real"] + 1j * v["stiffness_imag"]
+        bad = np.flatnonzero(np.abs(k) == 0)
+        if bad.size:
+            raise DataError(f"line {bad[0] + 2}: the stiffness is zero")
+    return MeasuredStiffness(v["frequency_hz"], v["amplitude"], k)
+
+
+def parse_loop(text: str | bytes) -> MeasuredLoop:
+    """Parse a measured-loop CSV: columns time_s, displacement, force, time strictly
+    increasing."""
+    df = _table(text, "loop")
+    cols = list(df.columns)
+    if sorted(cols) != sorted(LOOP_COLUMNS):
+        raise DataError(f"line 1: the header must be {', '.join(LOOP_COLUMNS)} (found: {', '.join(cols)})")
+    _rows(df, "loop")
+    v = _numbers(df, LOOP_COLUMNS, "loop")
+    if len(df) < 16:
+        raise DataError(f"loop file has {len(df)} rows; at least 16 are needed for one period")
+    step = np.diff(v["time_s"])
+    bad = np.flatnonzero(step <= 0)
+    if bad.size:
+        raise DataError(f"line {bad[0] + 3}: time_s must increase (after {v['time_s'][bad[0]]:g})")
+    if np.ptp(v["displacement"]) == 0:
+        raise DataError("loop file: the displacement never moves")
+    return MeasuredLoop(v["time_s"], v["displacement"], v["force"])

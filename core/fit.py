@@ -1,0 +1,246 @@
+"""Identification of the five material parameters from measured data (issue 4).
+
+Two procedures:
+
+* :func:`fit_global`: all five parameters to all data at once. The misfit is the complex
+  relative error of stiffness, (K_model − K_data)/|K_data| (real and imaginary parts), the same
+  quantity as the gap of FORMATS.md, plus, when a measured loop is given, the loop force error
+  relative to its RMS, weighted so that the loop counts as much as the stiffness points.
+  Parameters are fitted as ln µ, ln m, α, ln σ_fmax, ln ε½ (positive by construction; α bounded
+  to (0, 1]); bounded least squares (trust-region reflective) from several starting points, and
+  the best is kept.
+* :func:`fit_two_step`: the thesis' procedure (Paper B): the quasi-static loop gives µ, σ_fmax
+  and ε½; a frequency sweep at one amplitude gives m and α; the two steps alternate until
+  neither moves.
+
+Standard errors come from the Jacobian at the optimum, cov = s² (JᵀJ)⁻¹ with s² the residual
+variance, carried to the natural parameters by the delta method; the correlation matrix is that
+of the fitted (log) parameters, which the monotone transforms leave unchanged to first order.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from .bushing import loop_force, stiffness_points
+from .data import MeasuredLoop, MeasuredStiffness
+from .design import Design, Material, as_dict
+
+PARAMETERS = (
+    "shear_modulus",
+    "fractional_coefficient",
+    "fractional_order",
+    "friction_stress_max",
+    "friction_strain_half",
+)
+LOG = {"shear_modulus", "fractional_coefficient", "friction_stress_max", "friction_strain_half"}
+ORDER_BOUNDS = (1e-3, 1.0)
+# bounds of the fitted values, far wider than any rubber: they keep the search finite
+VALUE_BOUNDS = {
+    "shear_modulus": (1e2, 1e11),
+    "fractional_coefficient": (1e-2, 1e11),
+    "fractional_order": ORDER_BOUNDS,
+    "friction_stress_max": (1e-3, 1e9),
+    "friction_strain_half": (1e-9, 10.0),
+}
+
+
+def gap(model: np.ndarray, data: np.ndarray) -> float:
+    """FORMATS.md's gap: sqrt(mean(|K_model − K_data|² / |K_data|²))."""
+    return float(np.sqrt(np.mean(np.abs(model - data) ** 2 / np.abs(data) ** 2)))
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """A fitted design with its uncertainties and misfit."""
+
+    design: Design
+    standard_errors: dict[str, float]
+    correlation: dict[str, dict[str, float]]
+    gap: float  # over the stiffness points (NaN without them)
+    cost: float
+    points: int
+    method: str
+    starts: int = 1
+    loop_rms: float | None = None  # relative RMS force misfit of the loop, if one was fitted
+    history: list = field(default_factory=list)
+
+    def report(self) -> dict:
+        """The ``fit`` object of the fitted design file (FORMATS.md)."""
+        out = {
+            "standard_errors": self.standard_errors,
+            "correlation": self.correlation,
+            "gap": self.gap,
+            "points": self.points,
+            "method": self.method,
+            "starts": self.starts,
+        }
+        if self.loop_rms is not None:
+            out["loop_rms"] = self.loop_rms
+        return out
+
+    def to_dict(self) -> dict:
+        return {**self.design.to_dict(), "fit": self.report()}
+
+
+class _Problem:
+    """Residuals of a design's material against measured data, over a subset of parameters."""
+
+    def __init__(self, design: Design, data: MeasuredStiffness | None, loop: MeasuredLoop | None,
+                 free: tuple[str, ...]):
+        self.design, self.data, self.loop, self.free = design, data, loop, free
+        self.base = as_dict(design.material)
+        if loop is not None:
+            self.loop_f, self.loop_amp, self.loop_phase = loop.harmonic()
+            self.loop_force = loop.force - np.mean(loop.force)
+            self.loop_scale = float(np.sqrt(np.mean(self.loop_force**2)))
+            n_k = 0 if data is None else len(data)
+            # the loop weighs as much as the stiffness points (or as one point per sample alone)
+            self.loop_weight = math.sqrt(max(n_k, loop.force.size) / loop.force.size)
+
+    def to_theta(self, material: dict) -> np.ndarray:
+        return np.array([math.log(material[p]) if p in LOG else material[p] for p in self.free])
+
+    def material(self, theta) -> Material:
+        values = dict(self.base)
+        for p, t in zip(self.free, theta):
+            values[p] = math.exp(t) if p in LOG else float(t)
+        return Material(**values)
+
+    def bounds(self):
+        lo = [math.log(VALUE_BOUNDS[p][0]) if p in LOG else VALUE_BOUNDS[p][0] for p in self.free]
+        hi = [math.log(VALUE_BOUNDS[p][1]) if p in LOG else VALUE_BOUNDS[p][1] for p in self.free]
+        return lo, hi
+
+    def residuals(self, theta) -> np.ndarray:
+        design = Design(self.design.mode, self.design.geometry, self.material(theta),
+                        effects=self.design.effects)
+        parts = []
+        if self.data is not None:
+            k = stiffness_points(design, self.data.frequency_hz, self.data.amplitude)
+            r = (k - self.data.stiffness) / np.abs(self.data.stiffness)
+            parts += [r.real, r.imag]
+        if self.loop is not None:
+            f = sum(loop_force(design, self.loop_f, self.loop_amp, self.loop_phase))
+            parts.append(self.loop_weight * (f - self.loop_force) / self.loop_scale)
+        return np.concatenate(parts)
+
+
+def _uncertainties(problem: _Problem, sol) -> tuple[dict, dict]:
+    n, p = sol.fun.size, len(problem.free)
+    dof = max(n - p, 1)
+    s2 = 2.0 * sol.cost / dof
+    jtj = sol.jac.T @ sol.jac
+    try:
+        cov = s2 * np.linalg.inv(jtj)
+    except np.linalg.LinAlgError:
+        cov = s2 * np.linalg.pinv(jtj)
+    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    material = problem.material(sol.x)
+    errors = {}
+    for i, name in enumerate(problem.free):
+        value = getattr(material, name)
+        errors[name] = float(value * sd[i] if name in LOG else sd[i])  # delta method
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(sd, sd)
+    correlation = {a: {b: float(np.round(corr[i, j], 12)) for j, b in enumerate(problem.free)}
+                   for i, a in enumerate(problem.free)}
+    return errors, correlation
+
+
+def _starts(problem: _Problem, n: int, seed: int = 0) -> list[np.ndarray]:
+    """The design's own values first, then a seeded Latin-hypercube spread around them:
+    moduli and ε½ within a factor 10 either way, α across (0.05, 0.8)."""
+    first = problem.to_theta(problem.base)
+    if n <= 1:
+        return [first]
+    rng = np.random.default_rng(seed)
+    starts = [first]
+    cols = []
+    for _ in problem.free:
+        cols.append(rng.permutation((np.arange(n - 1) + rng.random(n - 1)) / (n - 1)))
+    for k in range(n - 1):
+        theta = []
+        for j, name in enumerate(problem.free):
+            u = cols[j][k]
+            if name == "fractional_order":
+                theta.append(0.05 + 0.75 * u)
+            else:
+                theta.append(first[j] + math.log(10.0) * (2 * u - 1))
+        starts.append(np.array(theta))
+    return starts
+
+
+def _solve(problem: _Problem, starts: list[np.ndarray]):
+    lo, hi = problem.bounds()
+    best = None
+    for theta0 in starts:
+        theta0 = np.clip(theta0, lo, hi)
+        try:
+            sol = least_squares(problem.residuals, theta0, bounds=(lo, hi), method="trf",
+                                x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=400)
+        except (ValueError, FloatingPointError, OverflowError):
+            continue  # a start the model cannot evaluate: try the next
+        if np.all(np.isfinite(sol.fun)) and (best is None or sol.cost < best.cost):
+            best = sol
+    if best is None:
+        raise ValueError("the fit failed from every starting point (check the data and the design)")
+    return best
+
+
+def _result(problem: _Problem, sol, method: str, starts: int, design: Design, errors=None, corr=None):
+    if errors is None:
+        errors, corr = _uncertainties(problem, sol)
+    fitted = Design(design.mode, design.geometry, problem.material(sol.x), name=design.name and f"{design.name} (fitted)",
+                    effects=design.effects)
+    g = float("nan")
+    if problem.data is not None:
+        g = gap(stiffness_points(fitted, problem.data.frequency_hz, problem.data.amplitude),
+                problem.data.stiffness)
+    loop_rms = None
+    if problem.loop is not None:
+        f = sum(loop_force(fitted, problem.loop_f, problem.loop_amp, problem.loop_phase))
+        loop_rms = float(np.sqrt(np.mean((f - problem.loop_force) ** 2)) / problem.loop_scale)
+    n = 0 if problem.data is None else len(problem.data)
+    return FitResult(fitted, errors, corr, g, float(sol.cost), n, method, starts, loop_rms)
+
+
+def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: MeasuredLoop | None = None,
+               *, starts: int = 8, free: tuple[str, ...] = PARAMETERS, seed: int = 0) -> FitResult:
+    """Fit the material parameters ``free`` of ``design`` to all the data at once.
+
+    ``design`` gives the geometry, the mode and the starting values; ``data`` measured
+    stiffness, ``loop`` a measured loop (at least one of the two). Returns a :class:`FitResult`.
+    """
+    if data is None and loop is None:
+        raise ValueError("give measured stiffness, a measured loop, or both")
+    n = (0 if data is None else 2 * len(data)) + (0 if loop is None else loop.force.size)
+    if n <= len(free):
+        raise ValueError(f"{n // 2} points cannot determine {len(free)} parameters")
+    problem = _Problem(design, data, loop, tuple(free))
+    sol = _solve(problem, _starts(problem, starts, seed))
+    return _result(problem, sol, "global", starts, design)
+
+
+def fit_two_step(design: Design, loop: MeasuredLoop, sweep: MeasuredStiffness,
+                 *, rounds: int = 2) -> FitResult:
+    """The thesis' identification (Paper B): the quasi-static loop gives µ, σ_fmax, ε½ (m and α
+    held), the one-amplitude frequency sweep gives m and α (the others held), ``rounds`` times;
+    then all five are refined together on the loop and the sweep (alternating steps alone creep
+    along the strong µ–m correlation), which is the point the alternation converges to."""
+    current = design
+    history = []
+    for _ in range(rounds):
+        step1 = fit_global(current, loop=loop, free=("shear_modulus", "friction_stress_max",
+                                                      "friction_strain_half"), starts=4)
+        step2 = fit_global(step1.design, data=sweep, free=("fractional_coefficient", "fractional_order"),
+                           starts=4)
+        current = step2.design
+        history.append(as_dict(current.material))
+    joint = fit_global(current, data=sweep, loop=loop, starts=1)
+    return FitResult(joint.design, joint.standard_errors, joint.correlation, joint.gap, joint.cost,
+                     joint.points, "two-step", 4, joint.loop_rms, [*history, as_dict(joint.design.material)])
