@@ -130,6 +130,15 @@ class Figure:
             if getattr(item.label, "value", item.label) != label:
                 item.label = value(label)
 
+    def points(self, key: str, label: str | None = None, **style):
+        """Markers (measured data)."""
+        src = ColumnDataSource({"x": np.array([]), "y": np.array([])})
+        self.sources[key] = src
+        self.renderers[key] = self.fig.scatter("x", "y", source=src, **style)
+        if label is not None and self.legend is not None:
+            self.legend.items.append(LegendItem(label=value(label), renderers=[self.renderers[key]]))
+        return self.renderers[key]
+
     def band(self, key: str, label: str | None = None, **style):
         src = ColumnDataSource({"x": np.array([]), "y1": np.array([]), "y2": np.array([])})
         self.sources[key] = src

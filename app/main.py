@@ -8,6 +8,7 @@ import sys
 
 import panel as pn
 
+from .measured import MeasuredView
 from .state import ExplorerState
 from .views import (
     URL_NAMES,
@@ -51,17 +52,19 @@ class App(pn.viewable.Viewer):
         self.plots = ExplorerPlots(self.state)
         self.slices = SlicesView(self.state)
         self.teaching = TeachingView(self.state)
+        self.measured = MeasuredView(self.state)
         self.compare = CompareView(self.state)
         self.export = ExportView(self.state)
         self.tabs = pn.Tabs(
             ("Explorer", pn.Column(self.compare, self.plots, sizing_mode="stretch_width")),
             ("Slices", self.slices),
             ("Fletcher–Gent, branch by branch", self.teaching),
+            ("Measured data and fit", self.measured),
             ("About", pn.pane.Markdown(ABOUT, sizing_mode="stretch_width")),
             dynamic=True,
             sizing_mode="stretch_width",
         )
-        self._tab_views = {0: self.plots, 1: self.slices, 2: self.teaching}
+        self._tab_views = {0: self.plots, 1: self.slices, 2: self.teaching, 3: self.measured}
         self.tabs.param.watch(self._on_tab, "active")
         self._on_tab()
 

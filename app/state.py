@@ -14,8 +14,10 @@ import numpy as np
 import param
 
 from core import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material
-from core.bushing import branch_stiffness, loop, stiffness, strain_factor
+from core.bushing import branch_stiffness, loop, stiffness, stiffness_points, strain_factor
+from core.data import DataError, MeasuredLoop, MeasuredStiffness, parse_loop, parse_stiffness
 from core.design import as_dict
+from core.fit import FitResult, fit_global
 from core.material import ConvergenceError
 
 # display parameter → (design key, factor from display unit to SI)
@@ -100,7 +102,15 @@ class ExplorerState(param.Parameterized):
 
     effects = param.Dict(default={}, doc="Model extensions carried by a loaded design.")
 
+    measured = param.ClassSelector(class_=MeasuredStiffness, default=None, allow_None=True,
+                                   doc="Measured dynamic stiffness (SI).")
+    measured_loop = param.ClassSelector(class_=MeasuredLoop, default=None, allow_None=True,
+                                        doc="A measured steady loop (SI).")
+    data_message = param.String(default="", doc="What was wrong with the last file, if anything.")
+    fit_result = param.ClassSelector(class_=FitResult, default=None, allow_None=True)
+
     def __init__(self, **params):
+        self._loaded = []  # the last design loaded (a file, a fit): kept while the inputs show it
         super().__init__(**params)
         self.param.watch(self._keep_strain_on_mode_change, ["mode", "amplitude"])
         self._validate()
@@ -155,7 +165,7 @@ class ExplorerState(param.Parameterized):
             except DesignError as exc:
                 errors[ERROR_FIELD.get(exc.key, "mode")] = _plain(exc)
             else:
-                design = _match_preset(design)
+                design = _match_shown(design, [*PRESETS.values(), *self._loaded])
                 if design != self.design:
                     self.design = design
         fmin, fmax = self.freq_min, self.freq_max
@@ -170,11 +180,88 @@ class ExplorerState(param.Parameterized):
     def load_design(self, design: Design):
         """Show ``design`` (a preset, a file, a fit), its operating amplitude mid-range."""
         x_mid = self.fletcher_gent_amplitudes(design)[2]
+        self._loaded = [design]
         self.param.update(
             **_display_values(design),
             effects=design.effect_parameters,
             amplitude=float(f"{x_mid:.3g}"),
         )
+
+    # ---- measured data and fitting -----------------------------------------------------------
+
+    def load_measured(self, content: bytes | str, filename: str = "stiffness file") -> bool:
+        """Read a measured-stiffness CSV (FORMATS.md); on a bad file say why and keep the last."""
+        try:
+            data = parse_stiffness(content)
+        except DataError as exc:
+            self.data_message = f"{filename}: {exc}"
+            return False
+        self.param.update(measured=data, data_message="", fit_result=None)
+        return True
+
+    def load_measured_loop(self, content: bytes | str, filename: str = "loop file") -> bool:
+        """Read a measured-loop CSV; the operating point moves to the loop's frequency and
+        amplitude, so that the model's loop is drawn over the measured one."""
+        try:
+            data = parse_loop(content)
+            f, amp, _ = data.harmonic()
+        except DataError as exc:
+            self.data_message = f"{filename}: {exc}"
+            return False
+        x = amp / AMPLITUDE_DISPLAY[self.design.mode][1]
+        self.param.update(measured_loop=data, data_message="", fit_result=None,
+                          frequency_hz=float(np.clip(f, *FREQUENCY_BOUNDS)), amplitude=float(f"{x:.4g}"))
+        return True
+
+    def clear_measured(self):
+        self.param.update(measured=None, measured_loop=None, data_message="", fit_result=None)
+
+    def compute_fit(self) -> FitResult:
+        """Fit the five material parameters to the measured data (the current design is the
+        first start). Pure: safe to run in a worker thread; :meth:`run_fit` stores it."""
+        if self.measured is None and self.measured_loop is None:
+            raise ValueError("load measured stiffness (and optionally a loop) first")
+        return fit_global(self.design, self.measured, self.measured_loop)
+
+    def run_fit(self):
+        try:
+            self.fit_result = self.compute_fit()
+            self.data_message = ""
+        except ValueError as exc:
+            self.data_message = str(exc)
+
+    def use_fit(self):
+        """Take the fitted design into the explorer, keeping the operating point."""
+        if self.fit_result is None:
+            return
+        amplitude, frequency = self.amplitude, self.frequency_hz
+        self.load_design(self.fit_result.design)
+        self.param.update(amplitude=amplitude, frequency_hz=frequency)
+
+    def measured_points(self) -> dict | None:
+        """Measured points in display units, the model at each, and the residuals."""
+        d = self.measured
+        if d is None:
+            return None
+        scale = AMPLITUDE_DISPLAY[self.design.mode][1]
+        k_model = stiffness_points(self.design, d.frequency_hz, d.amplitude)
+        return {
+            "frequency_hz": d.frequency_hz,
+            "amplitude": d.amplitude / scale,
+            "magnitude": self._stiffness_display(d.magnitude),
+            "loss_factor": d.loss_factor,
+            "magnitude_residual_pct": 100 * (np.abs(k_model) / d.magnitude - 1),
+            "loss_factor_residual": k_model.imag / k_model.real - d.loss_factor,
+            "gap": float(np.sqrt(np.mean(np.abs(k_model - d.stiffness) ** 2 / d.magnitude**2))),
+        }
+
+    def measured_loop_points(self) -> dict | None:
+        lp = self.measured_loop
+        if lp is None:
+            return None
+        scale = AMPLITUDE_DISPLAY[self.design.mode][1]
+        return {"displacement": (lp.displacement - np.mean(lp.displacement)) / scale,
+                "force": lp.force - np.mean(lp.force)}
 
     def apply_url_values(self, values: dict):
         """Apply values from a shared link one by one, so one bad value spoils no other."""
@@ -351,12 +438,13 @@ class ExplorerState(param.Parameterized):
         return r.table()
 
 
-def _match_preset(design: Design) -> Design:
-    """The preset itself (exact SI values, its name) when the inputs show a preset."""
+def _match_shown(design: Design, known) -> Design:
+    """A known design itself (exact SI values, its name) when the inputs show it: a preset, or
+    the design last loaded from a file or a fit."""
     shown = _display_values(design)
-    for preset in PRESETS.values():
-        if _display_values(preset) == shown and not design.effects:
-            return preset
+    for candidate in known:
+        if _display_values(candidate) == shown and candidate.effects == design.effects:
+            return candidate
     return design
 
 

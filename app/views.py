@@ -232,7 +232,8 @@ class ExplorerPlots(PlotView):
     """Loop, |K| and loss factor against frequency and amplitude, linked by the operating
     point: a tap on a frequency axis sets the frequency, on an amplitude axis the amplitude."""
 
-    WATCH = ("design", "freq_min", "freq_max", "errors", "frequency_hz", "amplitude", "reference")
+    WATCH = ("design", "freq_min", "freq_max", "errors", "frequency_hz", "amplitude", "reference",
+             "measured", "measured_loop")
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
         axes = _axes(state.design.mode)
@@ -243,6 +244,7 @@ class ExplorerPlots(PlotView):
             self.loop.line(name, name, color=color, line_width=1.5)
         self.loop.line("reference", "reference", **plots.REFERENCE_STYLE)
         self.loop.line("total", "total", color="black", line_width=2.5)
+        self.loop.points("measured", "measured", size=4, color="#222222", alpha=0.5)
         titles = {
             ("magnitude", "frequency"): "|K| against frequency",
             ("loss_factor", "frequency"): "Loss factor against frequency",
@@ -258,6 +260,7 @@ class ExplorerPlots(PlotView):
             fig.lines("sweeps", [""] * n, palette, line_width=1.3)
             fig.line("reference", "reference", **plots.REFERENCE_STYLE)
             fig.line("operating", "operating point", color=plots.OPERATING_COLOR, line_width=3)
+            fig.points("measured", "measured", size=5, color="#222222", alpha=0.6, marker="circle")
             fig.on_tap(self._tap_frequency if axis == "frequency" else self._tap_amplitude)
             self.figures[(quantity, axis)] = fig
         self.summary = pn.pane.HTML("", sizing_mode="stretch_width", css_classes=["operating-point"],
@@ -281,6 +284,12 @@ class ExplorerPlots(PlotView):
             self.loop.set("reference", x=rl["displacement"], y=rl["force"])
         else:
             self.loop.clear("reference")
+        ml = s.measured_loop_points()
+        if ml is not None:
+            self.loop.set("measured", x=ml["displacement"], y=ml["force"])
+        else:
+            self.loop.clear("measured")
+        measured = s.measured_points()
         sweeps = {"frequency": s.frequency_sweep(), "amplitude": s.amplitude_sweep()}
         operating = {"frequency": s.frequency_sweep(amplitudes=s.amplitude),
                      "amplitude": s.amplitude_sweep(frequencies=s.frequency_hz)}
@@ -299,6 +308,11 @@ class ExplorerPlots(PlotView):
             else:
                 fig.clear("reference")
             fig.set_marker(s.frequency_hz if axis == "frequency" else s.amplitude)
+            if measured is not None:
+                fig.set("measured", x=measured["frequency_hz" if axis == "frequency" else "amplitude"],
+                        y=measured[quantity])
+            else:
+                fig.clear("measured")
         point = s.operating_point()
         self.summary.object = (
             f'<span class="op-summary"><b>Operating point</b>: <span class="op-point">{s.amplitude:.3g} '

@@ -5,48 +5,30 @@ the stated parameters and stated noise, so that a newcomer can try `bushing fit`
 
 Noise: each complex stiffness is multiplied by (1 + n), n complex Gaussian with 0.5 % standard
 deviation in its real and imaginary parts; loop forces get Gaussian noise of 0.5 % of their peak.
-The random generator is seeded (12345), so the files are reproducible.
+The random generators are seeded (12345 …), so the files are reproducible; the explorer's
+"Load the synthetic example" button makes the same Paper B data (core/synthetic.py).
 """
 
 from pathlib import Path
 
 import numpy as np
 
-from core import PAPER_B, TABLE_1, stiffness, write_design
-from core.bushing import loop_force
-from core.data import MeasuredStiffness
+from core import PAPER_B, TABLE_1, write_design
+from core.synthetic import loop_csv, paper_b_example, synthetic_stiffness
 
 HERE = Path(__file__).resolve().parent
-NOISE = 0.005
-
-
-def stiffness_set(design, freqs, amps, rng):
-    ff, xx = np.meshgrid(freqs, amps)
-    k = stiffness(design, freqs, amps).stiffness.ravel()
-    k = k * (1 + NOISE * (rng.standard_normal(k.size) + 1j * rng.standard_normal(k.size)))
-    return MeasuredStiffness(ff.ravel(), xx.ravel(), k)
-
-
-def loop_csv(design, f, amp, periods, per_period, rng):
-    t = np.arange(periods * per_period) / (per_period * f)
-    theta = 2 * np.pi * f * t
-    force = sum(loop_force(design, f, amp, theta))
-    force = force + NOISE * np.max(np.abs(force)) * rng.standard_normal(t.size)
-    lines = ["time_s,displacement,force"]
-    lines += [f"{a:.10g},{b:.10g},{c:.10g}" for a, b, c in zip(t, amp * np.sin(theta), force)]
-    return "\n".join(lines) + "\n"
 
 
 def main():
-    rng = np.random.default_rng(12345)
     # Paper B bushing (axial): the thesis' amplitudes, 1-100 Hz, 150 points; the 0.1 Hz, 1 mm loop
-    stiffness_set(PAPER_B, np.linspace(1, 100, 30), [0.013e-3, 0.04e-3, 0.1e-3, 0.17e-3, 0.35e-3], rng).to_csv(
-        HERE / "paper_b_stiffness.csv")
-    (HERE / "paper_b_loop.csv").write_text(loop_csv(PAPER_B, 0.1, 1e-3, 2, 200, rng))
-    stiffness_set(PAPER_B, np.linspace(1, 100, 100), [0.1e-3], rng).to_csv(HERE / "paper_b_sweep_0.1mm.csv")
+    data, loop = paper_b_example(PAPER_B)
+    data.to_csv(HERE / "paper_b_stiffness.csv")
+    (HERE / "paper_b_loop.csv").write_text(loop_csv(loop))
+    synthetic_stiffness(PAPER_B, np.linspace(1, 100, 100), [0.1e-3], seed=12347).to_csv(
+        HERE / "paper_b_sweep_0.1mm.csv")
     # Table 1 bushing (torsion): 10-100 Hz at five angles, as real and imaginary parts
-    stiffness_set(TABLE_1, np.linspace(10, 100, 19), [1.74e-5, 1.74e-4, 1.74e-3, 1.74e-2, 1.74e-1], rng).to_csv(
-        HERE / "table1_torsion_stiffness.csv", polar=False)
+    synthetic_stiffness(TABLE_1, np.linspace(10, 100, 19), [1.74e-5, 1.74e-4, 1.74e-3, 1.74e-2, 1.74e-1],
+                        seed=12348).to_csv(HERE / "table1_torsion_stiffness.csv", polar=False)
     # starting guesses: the right geometry, a deliberately poor material
     write_design(PAPER_B.replace(name="Paper B geometry, starting guess", shear_modulus=1.5e6,
                                  fractional_coefficient=1.0e6, fractional_order=0.4,

@@ -11,7 +11,7 @@ from numpy.testing import assert_allclose
 
 from app.main import App, create_app
 from app.state import ExplorerState
-from core import PAPER_B, TABLE_1, loads_design, loop, stiffness
+from core import PAPER_B, TABLE_1, loads_design, loop, stiffness, stiffness_points
 
 
 @pytest.fixture
@@ -236,3 +236,66 @@ def test_hidden_tabs_catch_up_when_shown(app):
     app.tabs.active = 1
     fresh = np.asarray(app.slices.figures["magnitude"].sources["1"].data["y"])
     assert np.all(fresh > stale)
+
+
+# ---- measured data and fitting (issue 4) ---------------------------------------------------
+
+
+def example_files():
+    from core.synthetic import loop_csv, paper_b_example
+
+    data, loop = paper_b_example(PAPER_B)
+    return data.to_csv().encode(), loop_csv(loop).encode()
+
+
+def test_measured_points_appear_over_the_model(app):
+    stiff, loop_bytes = example_files()
+    app.inputs.widgets["shear_modulus_mpa"].value = 2.0  # a design that misses the data
+    assert app.state.load_measured(stiff, "s.csv")
+    app.tabs.active = 0
+    x, y = data(figure(app, "magnitude", "frequency"), "measured")
+    assert len(x) == 150 and np.all(y > 0)
+    points = app.state.measured_points()
+    k_model = stiffness_points(app.state.design, points["frequency_hz"], points["amplitude"] * 1e-3)
+    assert_allclose(points["magnitude_residual_pct"], 100 * (np.abs(k_model) / app.state.measured.magnitude - 1))
+    assert app.state.load_measured_loop(loop_bytes, "l.csv")
+    assert app.state.frequency_hz == pytest.approx(0.1) and app.state.amplitude == pytest.approx(1.0)
+    lx, lf = data(app.plots.loop, "measured")
+    assert len(lx) == 400 and np.max(np.abs(lx)) == pytest.approx(1.0, rel=1e-6)
+
+
+def test_bad_files_leave_a_message_and_the_session_going(app):
+    assert not app.state.load_measured(b"frequency_hz,amplitude,magnitude,loss_factor\n10,1e-4,abc,0.1\n", "bad.csv")
+    assert app.state.data_message == "bad.csv: line 2: magnitude is not a number ('abc')"
+    assert app.state.measured is None
+    app.tabs.active = 3
+    assert "line 2" in app.measured.message.object
+    assert not app.state.load_measured_loop(b"", "empty.csv")
+    assert "empty" in app.state.data_message
+    app.measured.stiffness_file.value = b"\xff\xfe"  # not even text
+    assert "UTF-8" in app.state.data_message
+    assert app.state.errors == {} and app.state.design == PAPER_B
+
+
+def test_fit_in_the_app_and_take_it_into_the_explorer(app):
+    stiff, loop_bytes = example_files()
+    app.state.load_measured(stiff)
+    app.state.load_measured_loop(loop_bytes)
+    app.state.param.update(shear_modulus_mpa=1.5, friction_strain_half=2e-3)
+    app.tabs.active = 3
+    app.state.run_fit()
+    r = app.state.fit_result
+    assert r.gap < 0.01 and not app.measured.use.disabled
+    assert "Correlation" in app.measured.results.object
+    f_op, x_op = app.state.frequency_hz, app.state.amplitude
+    app.state.use_fit()
+    assert app.state.design.material.shear_modulus == pytest.approx(r.design.material.shear_modulus, rel=1e-9)
+    assert (app.state.frequency_hz, app.state.amplitude) == (f_op, x_op)
+    assert app.state.measured_points()["gap"] == pytest.approx(r.gap, rel=1e-6)
+    fitted = loads_design(app.measured._fitted_json().getvalue())
+    assert fitted.material == r.design.material
+
+
+def test_fit_without_data_says_so(app):
+    app.state.run_fit()
+    assert "load measured" in app.state.data_message and app.state.fit_result is None

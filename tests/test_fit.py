@@ -6,29 +6,22 @@ import pytest
 from numpy.testing import assert_allclose
 
 from core import PAPER_B, TABLE_1, stiffness, stiffness_points
-from core.bushing import loop_force
-from core.data import MeasuredLoop, MeasuredStiffness
+from core.data import MeasuredLoop
 from core.design import as_dict
 from core.fit import PARAMETERS, fit_global, fit_two_step
+from core.synthetic import synthetic_loop as make_loop
+from core.synthetic import synthetic_stiffness
 
 NOISE = 0.005
 
 
 def synthetic(design, freqs, amps, seed, noise=NOISE):
-    rng = np.random.default_rng(seed)
-    ff, xx = np.meshgrid(freqs, amps)
-    k = stiffness_points(design, ff.ravel(), xx.ravel())
-    k = k * (1 + noise * (rng.standard_normal(k.size) + 1j * rng.standard_normal(k.size)))
-    return MeasuredStiffness(ff.ravel(), xx.ravel(), k)
+    return synthetic_stiffness(design, freqs, amps, noise=noise, seed=seed)
 
 
 def synthetic_loop(design, f, amp, seed, periods=2, per_period=200, phase=0.3, offset=(2e-6, 15.0)):
-    rng = np.random.default_rng(seed)
-    t = np.arange(periods * per_period) / (per_period * f)
-    theta = 2 * np.pi * f * t + phase
-    force = sum(loop_force(design, f, amp, theta))
-    force = force + NOISE * np.max(np.abs(force)) * rng.standard_normal(t.size)
-    return MeasuredLoop(t, amp * np.sin(theta) + offset[0], force + offset[1])
+    lp = make_loop(design, f, amp, periods=periods, per_period=per_period, phase=phase, seed=seed)
+    return MeasuredLoop(lp.time_s, lp.displacement + offset[0], lp.force + offset[1])
 
 
 CASES = {

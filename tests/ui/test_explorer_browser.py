@@ -219,3 +219,32 @@ def test_slices_tap_and_teaching_play(page, explorer_url):
     page.wait_for_timeout(1500)
     assert page.locator(".frame-point").inner_text() != first
     assert plots(page)["Loop shape during the amplitude sweep"]["signature"] != before
+
+
+def test_upload_fit_and_use(page, explorer_url, tmp_path):
+    from core import PAPER_B
+    from core.synthetic import paper_b_example
+
+    data, _ = paper_b_example(PAPER_B)
+    good = tmp_path / "measured.csv"
+    data.to_csv(good)
+    bad = tmp_path / "bad.csv"
+    bad.write_text("frequency_hz,amplitude,magnitude,loss_factor\n10,1e-4,,0.1\n")
+    open_explorer(page, explorer_url)
+    page.get_by_text("Measured data and fit", exact=True).click()
+    page.get_by_role("button", name="Fit the five material parameters").wait_for(timeout=20000)
+    inputs = page.locator("input[type=file]")
+    inputs.first.set_input_files(str(bad))
+    page.locator(".data-error").wait_for(timeout=10000)
+    assert "line 2: magnitude is missing" in page.locator(".data-error").inner_text()
+    inputs.first.set_input_files(str(good))
+    page.locator(".data-error").wait_for(state="detached", timeout=10000)
+    page.get_by_text("150 points").first.wait_for(timeout=10000)
+    page.get_by_role("button", name="Fit the five material parameters").click()
+    page.get_by_text("Correlation between parameters").wait_for(timeout=20000)
+    page.get_by_role("button", name="Use the fitted design in the explorer").click()
+    page.get_by_text("VP 40/70120 (Paper B) (fitted)").first.wait_for(timeout=10000)
+    page.get_by_text("Explorer", exact=True).click()
+    wait_quiet(page)
+    measured = [p for p in plots(page).items() if p[0] == "|K| against frequency"][0][1]
+    assert measured["points"] > 150 * 2  # curves and the 150 measured points

@@ -1,0 +1,181 @@
+"""The measured-data tab: load stiffness and loop files, see them over the model, fit the five
+material parameters, take the fitted design into the explorer. Thin: the state does the work."""
+
+from __future__ import annotations
+
+import asyncio
+import io
+import json
+import logging
+
+import numpy as np
+import panel as pn
+from bokeh.models import DataRange1d
+
+from core import PAPER_B
+from core.fit import PARAMETERS
+from core.synthetic import loop_csv, paper_b_example
+
+from . import plots
+from .figures import Axis, Figure
+from .state import ExplorerState
+from .views import PlotView
+
+log = logging.getLogger("bushing.app")
+
+LABELS = {
+    "shear_modulus": ("µ", 1e6, "MPa"),
+    "fractional_coefficient": ("m", 1e6, "MPa·s^α"),
+    "fractional_order": ("α", 1.0, ""),
+    "friction_stress_max": ("σ_fmax", 1e3, "kPa"),
+    "friction_strain_half": ("ε½", 1.0, ""),
+}
+
+
+class MeasuredView(PlotView):
+    """Upload, fit and residuals."""
+
+    WATCH = ("design", "measured", "measured_loop", "fit_result", "data_message")
+
+    def __init__(self, state: ExplorerState, **params):
+        super().__init__(state, **params)
+        self.stiffness_file = pn.widgets.FileInput(
+            accept=".csv,text/csv", description="Measured dynamic stiffness: frequency_hz, amplitude, "
+            "magnitude, loss_factor (or stiffness_real, stiffness_imag), SI units.", sizing_mode="stretch_width")
+        self.loop_file = pn.widgets.FileInput(
+            accept=".csv,text/csv", description="A measured steady loop: time_s, displacement, force (SI).",
+            sizing_mode="stretch_width")
+        self.stiffness_file.param.watch(self._on_stiffness_file, "value")
+        self.loop_file.param.watch(self._on_loop_file, "value")
+        self.example = pn.widgets.Button(label="Load the synthetic Paper B example", color="light")
+        self.example.on_click(self._load_example)
+        self.clear = pn.widgets.Button(label="Clear the data", color="light")
+        self.clear.on_click(lambda _e: state.clear_measured())
+        self.fit_button = pn.widgets.Button(label="Fit the five material parameters", color="primary",
+                                            description="Global fit to all loaded data from 8 starting points; "
+                                            "the current design is the first.")
+        self.fit_button.on_click(self._fit)
+        self.use = pn.widgets.Button(label="Use the fitted design in the explorer", color="success",
+                                     disabled=True)
+        self.use.on_click(lambda _e: state.use_fit())
+        self.download = pn.widgets.FileDownload(callback=self._fitted_json, filename="bushing-fitted.json",
+                                                label="Fitted design file (JSON)", disabled=True,
+                                                sizing_mode="stretch_width")
+        self.message = pn.pane.HTML("", sizing_mode="stretch_width")
+        self.summary = pn.pane.Markdown("", sizing_mode="stretch_width")
+        self.results = pn.pane.Markdown("", sizing_mode="stretch_width")
+        axes = {"frequency": Axis("frequency_hz", "Frequency", "Hz"), "amplitude": Axis("amplitude", "Amplitude", "")}
+        shared_y = {"magnitude": DataRange1d(), "loss": DataRange1d()}
+        for which, x in axes.items():
+            for quantity, y in (("magnitude", Axis("residual", "|K| residual", "%")),
+                                ("loss", Axis("residual", "Loss-factor residual", ""))):
+                fig = Figure(f"{y.label}, model − measured, against {x.label.lower()}", x, y,
+                             x_log=which == "amplitude", y_range=shared_y[quantity], legend=None, height=240,
+                             png=f"bushing-residual-{quantity}-vs-{which}")
+                fig.points("points", size=6, color=plots.OPERATING_COLOR, alpha=0.7)
+                self.figures[(quantity, which)] = fig
+        self._start()
+
+    # uploads run in the session: a bad file only sets a message
+
+    def _on_stiffness_file(self, event):
+        if event.new:
+            self.state.load_measured(event.new, self.stiffness_file.filename or "stiffness file")
+
+    def _on_loop_file(self, event):
+        if event.new:
+            self.state.load_measured_loop(event.new, self.loop_file.filename or "loop file")
+
+    def _load_example(self, _event):
+        data, loop = paper_b_example(PAPER_B)
+        self.state.load_measured(data.to_csv(), "paper_b_stiffness.csv")
+        self.state.load_measured_loop(loop_csv(loop), "paper_b_loop.csv")
+
+    async def _fit(self, _event):
+        self.fit_button.loading = True
+        try:
+            result = await asyncio.to_thread(self.state.compute_fit)  # the server stays responsive
+        except ValueError as exc:
+            self.state.data_message = str(exc)
+        else:
+            self.state.fit_result = result
+        finally:
+            self.fit_button.loading = False
+
+    def _fitted_json(self):
+        r = self.state.fit_result
+        return io.StringIO(json.dumps(r.to_dict(), indent=2) + "\n") if r is not None else io.StringIO("")
+
+    def _set_axes(self, axes):
+        for (_quantity, which), fig in self.figures.items():
+            x = axes["frequency"] if which == "frequency" else axes["amplitude"]
+            fig.set_axes(x, fig.y)
+
+    def _update(self):
+        s = self.state
+        self.message.object = (f'<div class="data-error" style="color:#b03a2e">⚠ {s.data_message}</div>'
+                               if s.data_message else "")
+        points = s.measured_points()
+        lines = []
+        if s.measured is not None:
+            d = s.measured
+            lines.append(f"**Stiffness**: {len(d)} points, {d.frequency_hz.min():.3g}–{d.frequency_hz.max():.3g} Hz, "
+                         f"amplitudes {points['amplitude'].min():.3g}–{points['amplitude'].max():.3g} {s.amplitude_unit}; "
+                         f"gap of the current design: **{points['gap']:.4f}**")
+        if s.measured_loop is not None:
+            f, amp, _ = s.measured_loop.harmonic()
+            unit_scale = 1e3 if s.design.mode == "axial" else 1.0
+            lines.append(f"**Loop**: {s.measured_loop.time_s.size} samples at {f:.3g} Hz, amplitude "
+                         f"{amp * unit_scale:.3g} {s.amplitude_unit}")
+        self.summary.object = "\n\n".join(lines) or "_No measured data loaded._"
+        for (quantity, which), fig in self.figures.items():
+            if points is None:
+                fig.clear("points")
+                continue
+            y = points["magnitude_residual_pct"] if quantity == "magnitude" else points["loss_factor_residual"]
+            fig.set("points", x=points["frequency_hz" if which == "frequency" else "amplitude"], y=y)
+        r = s.fit_result
+        self.use.disabled = self.download.disabled = r is None
+        self.results.object = self._results_table(r) if r is not None else ""
+
+    @staticmethod
+    def _results_table(r):
+        rows = ["| parameter | fitted | ± standard error |", "|---|---|---|"]
+        for p in PARAMETERS:
+            sym, scale, unit = LABELS[p]
+            value, err = getattr(r.design.material, p) / scale, r.standard_errors[p] / scale
+            rows.append(f"| {sym} ({unit or '–'}) | {value:.5g} | {err:.2g} |")
+        gap = f"{r.gap:.4f}" if np.isfinite(r.gap) else "–"
+        loop = f", loop RMS misfit {r.loop_rms:.4f}" if r.loop_rms is not None else ""
+        corr = ["| | " + " | ".join(LABELS[p][0] for p in PARAMETERS) + " |",
+                "|---" * (len(PARAMETERS) + 1) + "|"]
+        for a in PARAMETERS:
+            corr.append(f"| {LABELS[a][0]} | " + " | ".join(f"{r.correlation[a][b]:+.2f}" for b in PARAMETERS) + " |")
+        return (f"### Fitted\n\nGap (relative RMS misfit of complex stiffness): **{gap}**{loop}; "
+                f"{r.points} points, {r.starts} starts.\n\n" + "\n".join(rows)
+                + "\n\n**Correlation between parameters**\n\n" + "\n".join(corr))
+
+    def __panel__(self):
+        return pn.Column(
+            pn.pane.Markdown(
+                "Load measured dynamic stiffness (and, if you have one, a quasi-static loop) as CSV "
+                "files in the formats of FORMATS.md (drop a file on a button or click it), or the "
+                "synthetic example. The points appear over the model in the Explorer tab; the "
+                "residuals are below. **Fit** identifies µ, m, α, σ_fmax and ε½ with standard "
+                "errors; then take the fitted design into the explorer or save it.",
+                sizing_mode="stretch_width"),
+            pn.Row(pn.Column("**Stiffness CSV**", self.stiffness_file, sizing_mode="stretch_width"),
+                   pn.Column("**Loop CSV** (optional)", self.loop_file, sizing_mode="stretch_width"),
+                   sizing_mode="stretch_width"),
+            pn.Row(self.example, self.clear),
+            self.message,
+            self.summary,
+            pn.Row(self.fit_button, self.use),
+            self.download,
+            self.results,
+            pn.Row(*(pn.pane.Bokeh(self.figures[(q, "frequency")].fig, sizing_mode="stretch_width", height=240)
+                     for q in ("magnitude", "loss")), sizing_mode="stretch_width"),
+            pn.Row(*(pn.pane.Bokeh(self.figures[(q, "amplitude")].fig, sizing_mode="stretch_width", height=240)
+                     for q in ("magnitude", "loss")), sizing_mode="stretch_width"),
+            sizing_mode="stretch_width",
+        )
