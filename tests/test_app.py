@@ -260,7 +260,7 @@ def test_measured_points_appear_over_the_model(app):
     assert_allclose(points["magnitude_residual_pct"], 100 * (np.abs(k_model) / app.state.measured.magnitude - 1))
     assert app.state.load_measured_loop(loop_bytes, "l.csv")
     assert app.state.frequency_hz == pytest.approx(0.1) and app.state.amplitude == pytest.approx(1.0)
-    lx, lf = data(app.plots.loop, "measured")
+    lx, _ = data(app.plots.loop, "measured")
     assert len(lx) == 400 and np.max(np.abs(lx)) == pytest.approx(1.0, rel=1e-6)
 
 

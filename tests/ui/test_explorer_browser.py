@@ -246,5 +246,5 @@ def test_upload_fit_and_use(page, explorer_url, tmp_path):
     page.get_by_text("VP 40/70120 (Paper B) (fitted)").first.wait_for(timeout=10000)
     page.get_by_text("Explorer", exact=True).click()
     wait_quiet(page)
-    measured = [p for p in plots(page).items() if p[0] == "|K| against frequency"][0][1]
+    measured = plots(page)["|K| against frequency"]
     assert measured["points"] > 150 * 2  # curves and the 150 measured points
