@@ -35,7 +35,7 @@ LABELS = {
 class MeasuredView(PlotView):
     """Upload, fit and residuals."""
 
-    WATCH = ("design", "measured", "measured_loop", "fit_result", "data_message")
+    WATCH = ("design", "measured", "measured_loop", "fit_result", "data_message", "fit_method")
 
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
@@ -55,6 +55,10 @@ class MeasuredView(PlotView):
                                             description="Global fit to all loaded data from 8 starting points; "
                                             "the current design is the first.")
         self.fit_button.on_click(self._fit)
+        self.method = pn.widgets.RadioButtonGroup.from_param(state.param.fit_method, description=state.param.fit_method.doc)
+        self.sweep = pn.widgets.Select(label="Sweep amplitude (two-step)", options={}, sizing_mode="stretch_width",
+                                       description=state.param.sweep_amplitude.doc)
+        self.sweep.param.watch(lambda e: setattr(state, "sweep_amplitude", e.new), "value")
         self.use = pn.widgets.Button(label="Use the fitted design in the explorer", color="success",
                                      disabled=True)
         self.use.on_click(lambda _e: state.use_fit())
@@ -134,6 +138,11 @@ class MeasuredView(PlotView):
                 continue
             y = points["magnitude_residual_pct"] if quantity == "magnitude" else points["loss_factor_residual"]
             fig.set("points", x=points["frequency_hz" if which == "frequency" else "amplitude"], y=y)
+        unit_scale = 1e3 if s.design.mode == "axial" else 1.0
+        options = {f"{a * unit_scale:.4g} {s.amplitude_unit}": a for a in s.measured_amplitudes()}
+        if options != self.sweep.options:
+            self.sweep.options = options
+        self.sweep.visible = s.fit_method == "two-step"
         r = s.fit_result
         self.use.disabled = self.download.disabled = r is None
         self.results.object = self._results_table(r) if r is not None else ""
@@ -151,7 +160,7 @@ class MeasuredView(PlotView):
                 "|---" * (len(PARAMETERS) + 1) + "|"]
         for a in PARAMETERS:
             corr.append(f"| {LABELS[a][0]} | " + " | ".join(f"{r.correlation[a][b]:+.2f}" for b in PARAMETERS) + " |")
-        return (f"### Fitted\n\nGap (relative RMS misfit of complex stiffness): **{gap}**{loop}; "
+        return (f"### Fitted ({r.method})\n\nGap (relative RMS misfit of complex stiffness): **{gap}**{loop}; "
                 f"{r.points} points, {r.starts} starts.\n\n" + "\n".join(rows)
                 + "\n\n**Correlation between parameters**\n\n" + "\n".join(corr))
 
@@ -170,6 +179,7 @@ class MeasuredView(PlotView):
             pn.Row(self.example, self.clear),
             self.message,
             self.summary,
+            pn.Row(self.method, self.sweep),
             pn.Row(self.fit_button, self.use),
             self.download,
             self.results,

@@ -17,7 +17,7 @@ from core import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material
 from core.bushing import branch_stiffness, loop, stiffness, stiffness_points, strain_factor
 from core.data import DataError, MeasuredLoop, MeasuredStiffness, parse_loop, parse_stiffness
 from core.design import as_dict
-from core.fit import FitResult, fit_global
+from core.fit import FitResult, fit_global, fit_two_step
 from core.material import ConvergenceError
 
 # display parameter → (design key, factor from display unit to SI)
@@ -108,6 +108,13 @@ class ExplorerState(param.Parameterized):
                                         doc="A measured steady loop (SI).")
     data_message = param.String(default="", doc="What was wrong with the last file, if anything.")
     fit_result = param.ClassSelector(class_=FitResult, default=None, allow_None=True)
+    fit_method = param.Selector(
+        objects=["global", "two-step"], default="global", label="Method",
+        doc="Global: all five parameters to all data at once. Two-step (the thesis'): the loop "
+        "gives µ, σ_fmax and ε½, the frequency sweep at one amplitude gives m and α.",
+    )
+    sweep_amplitude = param.Number(default=None, allow_None=True, label="Sweep amplitude",
+                                   doc="The amplitude (SI) whose frequency sweep the two-step fit uses.")
 
     def __init__(self, **params):
         self._loaded = []  # the last design loaded (a file, a fit): kept while the inputs show it
@@ -216,11 +223,27 @@ class ExplorerState(param.Parameterized):
     def clear_measured(self):
         self.param.update(measured=None, measured_loop=None, data_message="", fit_result=None)
 
+    def measured_amplitudes(self) -> list[float]:
+        """The distinct measured amplitudes (SI), most frequent first."""
+        if self.measured is None:
+            return []
+        values, counts = np.unique(self.measured.amplitude, return_counts=True)
+        return [float(v) for v in values[np.argsort(-counts, kind="stable")]]
+
     def compute_fit(self) -> FitResult:
         """Fit the five material parameters to the measured data (the current design is the
         first start). Pure: safe to run in a worker thread; :meth:`run_fit` stores it."""
         if self.measured is None and self.measured_loop is None:
             raise ValueError("load measured stiffness (and optionally a loop) first")
+        if self.fit_method == "two-step":
+            if self.measured is None or self.measured_loop is None:
+                raise ValueError("the two-step fit needs a loop and a frequency sweep: load both")
+            amps = self.measured_amplitudes()
+            amp = self.sweep_amplitude if self.sweep_amplitude in amps else amps[0]
+            sweep = self.measured.select(self.measured.amplitude == amp)
+            if len(sweep) < 3:
+                raise ValueError("the sweep at that amplitude has fewer than 3 points")
+            return fit_two_step(self.design, self.measured_loop, sweep)
         return fit_global(self.design, self.measured, self.measured_loop)
 
     def run_fit(self):

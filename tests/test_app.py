@@ -299,3 +299,20 @@ def test_fit_in_the_app_and_take_it_into_the_explorer(app):
 def test_fit_without_data_says_so(app):
     app.state.run_fit()
     assert "load measured" in app.state.data_message and app.state.fit_result is None
+
+
+def test_the_thesis_two_step_fit_in_the_app(app):
+    stiff, loop_bytes = example_files()
+    app.state.load_measured(stiff)
+    app.state.fit_method = "two-step"
+    app.state.run_fit()
+    assert "loop" in app.state.data_message  # needs both
+    app.state.load_measured_loop(loop_bytes)
+    app.tabs.active = 3
+    assert len(app.measured.sweep.options) == 5 and app.measured.sweep.visible
+    app.measured.sweep.value = 1e-4
+    app.state.run_fit()
+    r = app.state.fit_result
+    assert r.method == "two-step" and r.points == 30  # the 0.1 mm sweep
+    assert r.design.material.shear_modulus == pytest.approx(2.42e6, rel=0.03)
+    assert "two-step" in app.measured.results.object
