@@ -173,9 +173,10 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
     """Complex stiffness at paired points (frequency_hz[i], amplitude[i]), broadcast together:
     for measured data, which is no grid. Same model and options as :func:`stiffness`; no cache.
     """
-    f, x = np.broadcast_arrays(np.asarray(frequency_hz, float), np.asarray(amplitude, float))
-    shape = f.shape
-    f, x = f.ravel(), x.ravel()
+    # broadcast, not expanded: on a grid (F,) × (A, 1) the friction term is evaluated per
+    # amplitude and the fractional term per frequency, not at every point
+    f, x = np.asarray(frequency_hz, float), np.asarray(amplitude, float)
+    shape = np.broadcast_shapes(f.shape, x.shape)
     slices = _check_slices(slices)
     if route not in ROUTES:
         raise ValueError(f"route: must be one of {', '.join(ROUTES)}, got {route!r}")
@@ -197,12 +198,15 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
         k = shape_factor(geo, mode) * modulus(f, c * x)  # eqs 16–18
     else:
         nodes = continuum_nodes(geo, mode) if slices == "continuum" else slice_nodes(geo, mode, slices)
-        k = solve_series(nodes, drive=x, modulus=lambda eps: modulus(f[:, None], eps), strain_guess=c * x)
+        fp, xp = (np.broadcast_to(v, shape).ravel() for v in (f, x))
+        k = solve_series(nodes, drive=xp, modulus=lambda eps: modulus(fp[:, None], eps),
+                         strain_guess=c * xp).reshape(shape)
     if "inertia" in effects:
         k = inertia_correction(k, f, effects["inertia"]["mass"])
+    k = np.broadcast_to(k, shape)
     if not np.all(np.isfinite(k)):
         raise ValueError("the stiffness is not finite at these points (check the design's effects)")
-    return k.reshape(shape)
+    return np.array(k)
 
 
 @functools.lru_cache(maxsize=128)
