@@ -22,6 +22,7 @@ from typing import Literal
 import numpy as np
 
 from . import material as mat
+from .data import ComplexStiffness
 from .design import Design, Geometry
 from .effects import extended_modulus, inertia_correction, wave_stiffness
 from .material import REFERENCE_FREQUENCY_HZ
@@ -74,7 +75,7 @@ def _readonly(arr: np.ndarray) -> np.ndarray:
 
 
 @dataclass(frozen=True, eq=False)
-class StiffnessResult:
+class StiffnessResult(ComplexStiffness):
     """Dynamic stiffness on an amplitude × frequency grid.
 
     ``stiffness[i, j]`` is the complex K at ``amplitude[i]`` and ``frequency_hz[j]``, in
@@ -96,15 +97,6 @@ class StiffnessResult:
     @property
     def units(self) -> dict[str, str]:
         return {"frequency_hz": "Hz", **UNITS[self.mode]}
-
-    @property
-    def magnitude(self) -> np.ndarray:
-        return np.abs(self.stiffness)
-
-    @property
-    def loss_factor(self) -> np.ndarray:
-        """η = Im K / Re K (MODEL.md)."""
-        return self.stiffness.imag / self.stiffness.real
 
     def table(self) -> dict[str, np.ndarray]:
         """Flat columns in FORMATS.md's order, amplitude by amplitude, each a frequency sweep."""

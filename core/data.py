@@ -28,13 +28,10 @@ class DataError(ValueError):
     """A measured-data file breaks a rule; the message names the line and the reason."""
 
 
-@dataclass(frozen=True, eq=False)
-class MeasuredStiffness:
-    """Measured complex dynamic stiffness, one entry per (frequency, amplitude) point."""
+class ComplexStiffness:
+    """Magnitude and loss factor of a ``stiffness`` attribute holding complex K."""
 
-    frequency_hz: np.ndarray
-    amplitude: np.ndarray
-    stiffness: np.ndarray  # complex
+    stiffness: np.ndarray
 
     @property
     def magnitude(self) -> np.ndarray:
@@ -42,7 +39,17 @@ class MeasuredStiffness:
 
     @property
     def loss_factor(self) -> np.ndarray:
+        """η = Im K / Re K (MODEL.md)."""
         return self.stiffness.imag / self.stiffness.real
+
+
+@dataclass(frozen=True, eq=False)
+class MeasuredStiffness(ComplexStiffness):
+    """Measured complex dynamic stiffness, one entry per (frequency, amplitude) point."""
+
+    frequency_hz: np.ndarray
+    amplitude: np.ndarray
+    stiffness: np.ndarray  # complex
 
     def __len__(self):
         return self.frequency_hz.size

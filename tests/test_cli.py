@@ -12,6 +12,7 @@ from numpy.testing import assert_allclose
 
 from core import PAPER_B, TABLE_1, loop, stiffness, write_design
 from core.cli import main
+from tests.helpers import free_port, wait_for
 
 STIFFNESS_COLUMNS = ["frequency_hz", "amplitude", "stiffness_real", "stiffness_imag", "magnitude", "loss_factor"]
 LOOP_COLUMNS = ["displacement", "force", "force_elastic", "force_viscoelastic", "force_friction"]
@@ -154,33 +155,14 @@ def test_installed_entry_point_runs_without_traceback(designs, tmp_path):
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "Traceback" not in bad.stderr
 
 
-def _free_port():
-    import socket
-
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 def test_serve_prints_its_url_and_answers():
-    import time
-    import urllib.request
-
-    port = _free_port()
+    port = free_port()
     proc = subprocess.Popen([sys.executable, "-m", "core.cli", "serve", "--port", str(port)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         line = proc.stdout.readline()
         assert line.strip() == f"Bushing Explorer: http://localhost:{port}/"
-        deadline = time.time() + 30
-        while True:
-            try:
-                with urllib.request.urlopen(f"http://localhost:{port}/", timeout=5) as r:
-                    assert r.status == 200 and b"Bushing Explorer" in r.read()
-                    break
-            except OSError:
-                assert time.time() < deadline
-                time.sleep(0.3)
+        assert b"Bushing Explorer" in wait_for(f"http://localhost:{port}/")
     finally:
         proc.terminate()
         proc.wait(10)

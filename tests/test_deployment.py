@@ -1,10 +1,10 @@
 """The Dockerfile stays in step with the README and the command line (no Docker engine here)."""
 
 import re
-import urllib.request
 from pathlib import Path
 
 from app.main import _origins
+from tests.helpers import free_port, wait_for
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCKERFILE = (ROOT / "Dockerfile").read_text(encoding="utf-8")
@@ -39,30 +39,16 @@ def test_websocket_origins():
     assert "localhost:5006" in _origins("localhost", 5006)
 
 
-def test_liveness_endpoint_answers(tmp_path):
+def test_liveness_endpoint_answers():
     """The endpoint the health check asks for, on a real server."""
-    import socket
-
     import panel as pn
 
     from app.main import create_app
 
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
+    port = free_port()
     server = pn.serve(create_app, port=port, address="127.0.0.1", show=False, threaded=True,
                       liveness=True, websocket_origin=[f"127.0.0.1:{port}"], verbose=False)
     try:
-        import time
-
-        deadline = time.time() + 30
-        while True:
-            try:
-                with urllib.request.urlopen(f"http://127.0.0.1:{port}/liveness", timeout=2) as r:
-                    assert r.status == 200 and b"true" in r.read()
-                    break
-            except OSError:
-                assert time.time() < deadline
-                time.sleep(0.2)
+        assert b"true" in wait_for(f"http://127.0.0.1:{port}/liveness")
     finally:
         server.stop()

@@ -3,11 +3,10 @@ system Chromium (Playwright's own browser download does not work here, so it is 
 
 import logging
 import shutil
-import socket
-import time
-import urllib.request
 
 import pytest
+
+from tests.helpers import free_port, wait_for
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
@@ -29,12 +28,6 @@ def browser_type_launch_args(browser_type_launch_args):
 @pytest.fixture(scope="session")
 def browser_context_args(browser_context_args):
     return {**browser_context_args, "viewport": {"width": 1500, "height": 1300}, "accept_downloads": True}
-
-
-def _free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 class ServerLog(logging.Handler):
@@ -65,22 +58,13 @@ def explorer_url(server_log):
 
     from app.main import create_app
 
-    port = _free_port()
+    port = free_port()
     server = pn.serve(
         create_app, port=port, address="127.0.0.1", show=False, threaded=True, liveness=True,
         websocket_origin=[f"127.0.0.1:{port}", f"localhost:{port}"], verbose=False,
     )
     url = f"http://127.0.0.1:{port}/"
-    deadline = time.time() + 30
-    while True:
-        try:
-            with urllib.request.urlopen(url + "liveness", timeout=2) as r:
-                if r.status == 200:
-                    break
-        except OSError:
-            if time.time() > deadline:
-                raise
-            time.sleep(0.2)
+    wait_for(url + "liveness")
     yield url
     server.stop()
 
