@@ -113,7 +113,7 @@ def _file_text(path, what: str) -> str:
     if size > MAX_BYTES:
         raise DataError(f"{what} file is too large ({size} bytes; at most {MAX_BYTES})")
     try:
-        return path.read_text(encoding="utf-8")
+        return path.read_text(encoding="utf-8-sig")  # a byte-order mark (Excel) is not data
     except UnicodeDecodeError:
         raise DataError(f"{what} file {str(path)!r} is not UTF-8 text") from None
     except OSError as exc:
@@ -126,9 +126,10 @@ def _table(text: str | bytes, what: str) -> pd.DataFrame:
         if len(text) > MAX_BYTES:
             raise DataError(f"{what} file is too large ({len(text)} bytes; at most {MAX_BYTES})")
         try:
-            text = text.decode("utf-8")
+            text = text.decode("utf-8-sig")
         except UnicodeDecodeError:
             raise DataError(f"{what} file is not UTF-8 text") from None
+    text = text.removeprefix("\ufeff")
     if len(text) > MAX_BYTES:
         raise DataError(f"{what} file is too large (at most {MAX_BYTES} bytes)")
     if not text.strip():

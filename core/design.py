@@ -218,7 +218,7 @@ def loads_design(text: str) -> Design:
 def read_design(path: str | Path) -> Design:
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark is not part of the JSON
     except OSError as exc:
         raise DesignError("", f"cannot read design file {str(path)!r}: {exc.strerror}")
     except UnicodeDecodeError:

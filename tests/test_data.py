@@ -156,3 +156,19 @@ def test_cli_fit_writes_the_fitted_design(tmp_path, capsys):
     assert report["correlation"]["shear_modulus"]["shear_modulus"] == pytest.approx(1.0)
     assert report["gap"] < 0.01
     assert fitted.material.shear_modulus == pytest.approx(2.42e6, rel=0.02)
+
+
+def test_byte_order_mark_and_windows_line_endings_are_accepted(tmp_path):
+    """Spreadsheets write a UTF-8 byte-order mark and CRLF; neither is data."""
+    path = tmp_path / "excel.csv"
+    path.write_bytes(b"\xef\xbb\xbf" + GOOD.replace("\n", "\r\n").encode())
+    assert_allclose(read_stiffness(path).magnitude, [4.2e6, 4.3e6])
+    assert_allclose(parse_stiffness(b"\xef\xbb\xbf" + GOOD.encode()).magnitude, [4.2e6, 4.3e6])
+
+
+def test_design_file_with_byte_order_mark(tmp_path):
+    from core import dumps_design, read_design
+
+    path = tmp_path / "d.json"
+    path.write_bytes(b"\xef\xbb\xbf" + dumps_design(PAPER_B).encode())
+    assert read_design(path) == PAPER_B
