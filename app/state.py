@@ -307,10 +307,6 @@ class ExplorerState(param.Parameterized):
     def stiffness_unit(self) -> str:
         return STIFFNESS_DISPLAY[self.design.mode][0]
 
-    @property
-    def force_unit(self) -> str:
-        return FORCE_DISPLAY[self.design.mode][0]
-
     @staticmethod
     def fletcher_gent_amplitudes(design: Design, n: int = 5) -> np.ndarray:
         """Drive amplitudes (display units) spanning the Fletcher–Gent range, ε̂/ε½ = 1e-3 … 1e2,
