@@ -17,7 +17,7 @@ from core import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material
 from core.bushing import branch_stiffness, loop, stiffness, stiffness_points, strain_factor
 from core.data import DataError, MeasuredLoop, MeasuredStiffness, parse_loop, parse_stiffness
 from core.design import as_dict
-from core.fit import FitResult, fit_global, fit_two_step
+from core.fit import FitResult, fit_global, fit_two_step, gap
 from core.material import ConvergenceError
 
 # display parameter → (design key, factor from display unit to SI)
@@ -275,7 +275,7 @@ class ExplorerState(param.Parameterized):
             "loss_factor": d.loss_factor,
             "magnitude_residual_pct": 100 * (np.abs(k_model) / d.magnitude - 1),
             "loss_factor_residual": k_model.imag / k_model.real - d.loss_factor,
-            "gap": float(np.sqrt(np.mean(np.abs(k_model - d.stiffness) ** 2 / d.magnitude**2))),
+            "gap": gap(k_model, d.stiffness),
         }
 
     def measured_loop_points(self) -> dict | None:
