@@ -79,6 +79,7 @@ class Figure:
         self.fig.yaxis.axis_label = y.title
         self.sources: dict[str, ColumnDataSource] = {}
         self.renderers = {}
+        self._line_colors: dict[str, list[str]] = {}
         self.legend = None
         if legend:
             self.legend = Legend(items=[], location="top_left" if legend == "inside" else "center",
@@ -97,24 +98,35 @@ class Figure:
                 mode="mouse",
             ))
 
-    def line(self, key: str, label: str | None = None, **style):
-        src = ColumnDataSource({"x": np.array([]), "y": np.array([])})
+    def _glyph(self, key: str, columns: tuple, draw, label: str | None):
+        """``draw(source)`` on a new empty source of ``columns``, in the legend under ``label``."""
+        src = ColumnDataSource({c: [] for c in columns})
         self.sources[key] = src
-        self.renderers[key] = self.fig.line("x", "y", source=src, **style)
+        self.renderers[key] = draw(src)
         if label is not None and self.legend is not None:
             self.legend.items.append(LegendItem(label=value(label), renderers=[self.renderers[key]]))
         return self.renderers[key]
 
+    def line(self, key: str, label: str | None = None, **style):
+        return self._glyph(key, ("x", "y"), lambda src: self.fig.line("x", "y", source=src, **style), label)
+
+    def points(self, key: str, label: str | None = None, **style):
+        """Markers (measured data)."""
+        return self._glyph(key, ("x", "y"), lambda src: self.fig.scatter("x", "y", source=src, **style), label)
+
+    def band(self, key: str, label: str | None = None, **style):
+        return self._glyph(key, ("x", "y1", "y2"),
+                           lambda src: self.fig.varea("x", "y1", "y2", source=src, **style), label)
+
     def lines(self, key: str, labels: list[str], colors: list[str], **style):
         """Several lines in one glyph and one source (one patch per update), each in the legend."""
-        src = ColumnDataSource({"xs": [], "ys": [], "color": []})
-        self.sources[key] = src
-        self.renderers[key] = self.fig.multi_line("xs", "ys", source=src, line_color="color", **style)
-        self._line_colors = {**getattr(self, "_line_colors", {}), key: list(colors)}
+        renderer = self._glyph(key, ("xs", "ys", "color"), lambda src: self.fig.multi_line(
+            "xs", "ys", source=src, line_color="color", **style), None)
+        self._line_colors[key] = list(colors)
         if self.legend is not None:
             for i, label in enumerate(labels):
-                self.legend.items.append(LegendItem(label=value(label), renderers=[self.renderers[key]], index=i))
-        return self.renderers[key]
+                self.legend.items.append(LegendItem(label=value(label), renderers=[renderer], index=i))
+        return renderer
 
     def set_lines(self, key: str, x, ys, labels: list[str]):
         """Replace the lines of :meth:`lines` (all on the same x) and relabel them if needed."""
@@ -129,23 +141,6 @@ class Figure:
         for item, label in zip(items, labels):
             if getattr(item.label, "value", item.label) != label:
                 item.label = value(label)
-
-    def points(self, key: str, label: str | None = None, **style):
-        """Markers (measured data)."""
-        src = ColumnDataSource({"x": np.array([]), "y": np.array([])})
-        self.sources[key] = src
-        self.renderers[key] = self.fig.scatter("x", "y", source=src, **style)
-        if label is not None and self.legend is not None:
-            self.legend.items.append(LegendItem(label=value(label), renderers=[self.renderers[key]]))
-        return self.renderers[key]
-
-    def band(self, key: str, label: str | None = None, **style):
-        src = ColumnDataSource({"x": np.array([]), "y1": np.array([]), "y2": np.array([])})
-        self.sources[key] = src
-        self.renderers[key] = self.fig.varea("x", "y1", "y2", source=src, **style)
-        if label is not None and self.legend is not None:
-            self.legend.items.append(LegendItem(label=value(label), renderers=[self.renderers[key]]))
-        return self.renderers[key]
 
     def set(self, key: str, **columns):
         self.sources[key].data = {k: np.asarray(v, dtype=float) for k, v in columns.items()}

@@ -128,9 +128,8 @@ class MeasuredView(PlotView):
                          f"gap of the current design: **{points['gap']:.4f}**")
         if s.measured_loop is not None:
             f, amp, _ = s.measured_loop.harmonic()
-            unit_scale = 1e3 if s.design.mode == "axial" else 1.0
             lines.append(f"**Loop**: {s.measured_loop.time_s.size} samples at {f:.3g} Hz, amplitude "
-                         f"{amp * unit_scale:.3g} {s.amplitude_unit}")
+                         f"{s.display_amplitude(amp):.3g} {s.amplitude_unit}")
         self.summary.object = "\n\n".join(lines) or "_No measured data loaded._"
         for (quantity, which), fig in self.figures.items():
             if points is None:
@@ -138,8 +137,7 @@ class MeasuredView(PlotView):
                 continue
             y = points["magnitude_residual_pct"] if quantity == "magnitude" else points["loss_factor_residual"]
             fig.set("points", x=points["frequency_hz" if which == "frequency" else "amplitude"], y=y)
-        unit_scale = 1e3 if s.design.mode == "axial" else 1.0
-        options = {f"{a * unit_scale:.4g} {s.amplitude_unit}": a for a in s.measured_amplitudes()}
+        options = {f"{s.display_amplitude(a):.4g} {s.amplitude_unit}": a for a in s.measured_amplitudes()}
         if options != self.sweep.options:
             self.sweep.options = options
         self.sweep.visible = s.fit_method == "two-step"

@@ -215,7 +215,7 @@ class ExplorerState(param.Parameterized):
         except DataError as exc:
             self.data_message = f"{filename}: {exc}"
             return False
-        x = amp / AMPLITUDE_DISPLAY[self.design.mode][1]
+        x = float(self.display_amplitude(amp))
         self.param.update(measured_loop=data, data_message="", fit_result=None,
                           frequency_hz=float(np.clip(f, *FREQUENCY_BOUNDS)), amplitude=float(f"{x:.4g}"))
         return True
@@ -266,11 +266,10 @@ class ExplorerState(param.Parameterized):
         d = self.measured
         if d is None:
             return None
-        scale = AMPLITUDE_DISPLAY[self.design.mode][1]
         k_model = stiffness_points(self.design, d.frequency_hz, d.amplitude)
         return {
             "frequency_hz": d.frequency_hz,
-            "amplitude": d.amplitude / scale,
+            "amplitude": self.display_amplitude(d.amplitude),
             "magnitude": self._stiffness_display(d.magnitude),
             "loss_factor": d.loss_factor,
             "magnitude_residual_pct": 100 * (np.abs(k_model) / d.magnitude - 1),
@@ -282,8 +281,7 @@ class ExplorerState(param.Parameterized):
         lp = self.measured_loop
         if lp is None:
             return None
-        scale = AMPLITUDE_DISPLAY[self.design.mode][1]
-        return {"displacement": (lp.displacement - np.mean(lp.displacement)) / scale,
+        return {"displacement": self.display_amplitude(lp.displacement - np.mean(lp.displacement)),
                 "force": lp.force - np.mean(lp.force)}
 
     def apply_url_values(self, values: dict):
@@ -323,6 +321,10 @@ class ExplorerState(param.Parameterized):
 
     def _si_amplitude(self, x):
         return np.asarray(x, dtype=float) * AMPLITUDE_DISPLAY[self.design.mode][1]
+
+    def display_amplitude(self, x_si):
+        """An amplitude in SI (m or rad) in the display unit (mm or rad)."""
+        return np.asarray(x_si, dtype=float) / AMPLITUDE_DISPLAY[self.design.mode][1]
 
     def _stiffness_display(self, k):
         return k / STIFFNESS_DISPLAY[self.design.mode][1]

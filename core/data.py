@@ -7,6 +7,7 @@ silently. All numbers are SI: Hz, m or rad, N/m or N·m/rad, s, N or N·m.
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import math
 import warnings
@@ -80,7 +81,11 @@ class MeasuredLoop:
 
     def harmonic(self):
         """Frequency (Hz), peak amplitude and the phase θ(t) of the drive x ≈ x̂ sin θ, from a
-        least-squares sine fit (frequency refined around the spectral peak)."""
+        least-squares sine fit (frequency refined around the spectral peak); computed once."""
+        return self._harmonic
+
+    @functools.cached_property
+    def _harmonic(self):
         t, x = self.time_s, self.displacement - np.mean(self.displacement)
         dt = np.median(np.diff(t))
         spec = np.abs(np.fft.rfft(x * np.hanning(x.size)))
