@@ -140,6 +140,25 @@ def build_parser() -> argparse.ArgumentParser:
     ft.add_argument("--loop", metavar="LOOP.csv", help="a measured steady loop (time_s, displacement, force)")
     ft.add_argument("-o", dest="output", metavar="FITTED.json", help="write here, not to stdout")
 
+    dg = sub.add_parser(
+        "diagnose",
+        help="find the effect the model is missing: where it disagrees, what is missing, the gap shrinking",
+        description="The discrepancy workflow: fit the baseline model, describe where it "
+        "disagrees with the measurement, name the missing effects of the library one by one "
+        "(ranked by BIC, with a threshold that does not add effects to fit noise), refit, and "
+        "report the gap before and after each step and on held-out data. The report (JSON) goes "
+        "to standard output, or to --json with a summary in plain words on standard output.",
+    )
+    dg.add_argument("measured", metavar="MEASURED.csv", help="measured stiffness (FORMATS.md)")
+    dg.add_argument("--design", required=True, metavar="DESIGN.json",
+                    help="geometry (known), mode and starting parameters")
+    dg.add_argument("--baseline", default="elastic,fractional,friction", metavar="IDS",
+                    help="the branches the starting model has, comma-separated from "
+                    "elastic,fractional,friction (default: all three)")
+    dg.add_argument("--json", dest="report", metavar="REPORT.json", help="write the report here")
+    dg.add_argument("--predictions", metavar="PRED.csv",
+                    help="write, per data row, the baseline's and the final model's |K| and loss factor")
+
     sv = sub.add_parser(
         "serve",
         help="start the explorer in the browser (embedded defaults, no setup)",
@@ -162,20 +181,24 @@ def _frequencies(args) -> np.ndarray:
     return np.geomspace(f1, f2, n) if args.log else np.linspace(f1, f2, n)
 
 
+def _write_text(text: str, output: str | None) -> None:
+    if output is None:
+        sys.stdout.write(text)
+        return
+    try:
+        with open(output, "w", encoding="utf-8", newline="") as fh:
+            fh.write(text)
+    except OSError as exc:
+        raise InputError(f"bushing: cannot write {output!r}: {exc.strerror}")
+
+
 def _write_csv(columns: dict[str, np.ndarray], output: str | None) -> None:
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(columns)
     for row in zip(*columns.values()):
         writer.writerow([NUMBER_FORMAT.format(v) for v in row])
-    if output is None:
-        sys.stdout.write(buf.getvalue())
-        return
-    try:
-        with open(output, "w", encoding="utf-8", newline="") as fh:
-            fh.write(buf.getvalue())
-    except OSError as exc:
-        raise InputError(f"bushing: cannot write {output!r}: {exc.strerror}")
+    _write_text(buf.getvalue(), output)
 
 
 def _cmd_stiffness(args) -> None:
@@ -230,15 +253,27 @@ def _cmd_fit(args) -> None:
     data = read_stiffness(args.measured)
     loop_data = read_loop(args.loop) if args.loop else None
     result = fit_global(design, data, loop_data)
-    text = json.dumps(result.to_dict(), indent=2) + "\n"
-    if args.output is None:
-        sys.stdout.write(text)
-        return
-    try:
-        with open(args.output, "w", encoding="utf-8") as fh:
-            fh.write(text)
-    except OSError as exc:
-        raise InputError(f"bushing: cannot write {args.output!r}: {exc.strerror}")
+    _write_text(json.dumps(result.to_dict(), indent=2) + "\n", args.output)
+
+
+def _cmd_diagnose(args) -> None:
+    from .data import read_stiffness
+    from .diagnose import BRANCHES, diagnose, summary
+
+    baseline = [b.strip() for b in args.baseline.split(",") if b.strip()]
+    wrong = [b for b in baseline if b not in BRANCHES]
+    if wrong or not baseline:
+        raise InputError(f"bushing diagnose: --baseline takes branches from {','.join(BRANCHES)}, "
+                         f"got {args.baseline!r}")
+    design = read_design(args.design)
+    data = read_stiffness(args.measured)
+    result = diagnose(design, data, baseline=baseline)
+    report = json.dumps(result.report(), indent=2, allow_nan=False) + "\n"
+    if args.predictions:
+        _write_csv(result.predictions(), args.predictions)
+    _write_text(report, args.report)
+    if args.report:
+        sys.stdout.write(summary(result))
 
 
 def _cmd_serve(args) -> None:
@@ -252,7 +287,8 @@ def _cmd_serve(args) -> None:
         raise InputError(f"bushing serve: cannot listen on {args.address}:{args.port}: {exc.strerror}")
 
 
-COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop, "fit": _cmd_fit, "serve": _cmd_serve}
+COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop, "fit": _cmd_fit, "diagnose": _cmd_diagnose,
+            "serve": _cmd_serve}
 
 
 def main(argv: list[str] | None = None) -> int:

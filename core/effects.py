@@ -32,6 +32,8 @@ class Parameter:
     name: str
     unit: str  # "axial/torsion" where the unit depends on the mode
     meaning: str
+    bounds: tuple[float, float] = (0.0, math.inf)  # the range searched when fitting
+    log: bool = True  # fitted as its logarithm (a scale), or as itself
 
 
 @dataclass(frozen=True)
@@ -42,6 +44,8 @@ class Effect:
     physics: str
     signature: str
     branch: bool = False  # one of the thesis' own branches (parameters live in `material`)
+    requires: tuple[str, ...] = ()  # acts only on one of these (branches or effects)
+    excludes: tuple[str, ...] = ()  # cannot be combined with these effects
 
 
 EFFECTS: dict[str, Effect] = {
@@ -51,8 +55,8 @@ EFFECTS: dict[str, Effect] = {
             "friction",
             "Amplitude dependence (Fletcher–Gent effect)",
             (
-                Parameter("friction_stress_max", "Pa", "largest friction stress σ_fmax"),
-                Parameter("friction_strain_half", "–", "strain ε½ to build half of σ_fmax"),
+                Parameter("friction_stress_max", "Pa", "largest friction stress σ_fmax", (1e-3, 1e9)),
+                Parameter("friction_strain_half", "–", "strain ε½ to build half of σ_fmax", (1e-9, 10.0)),
             ),
             "The carbon-black filler network breaks and re-forms as the rubber is strained: "
             "a rate-independent friction stress that saturates at σ_fmax (Berg's smooth "
@@ -65,8 +69,8 @@ EFFECTS: dict[str, Effect] = {
             "fractional",
             "Frequency dependence (fractional viscoelasticity)",
             (
-                Parameter("fractional_coefficient", "Pa·s^α", "fractional coefficient m"),
-                Parameter("fractional_order", "–", "fractional order α in (0, 1]"),
+                Parameter("fractional_coefficient", "Pa·s^α", "fractional coefficient m", (1e-2, 1e11)),
+                Parameter("fractional_order", "–", "fractional order α in (0, 1]", (1e-3, 1.0), log=False),
             ),
             "The rubber's polymer chains relax over a broad spectrum of times, which a "
             "fractional derivative of order α captures with two numbers.",
@@ -77,7 +81,7 @@ EFFECTS: dict[str, Effect] = {
         Effect(
             "inertia",
             "Apparent mass seen by the force sensor",
-            (Parameter("mass", "kg/kg·m²", "apparent mass M (kg axially, kg·m² in torsion)"),),
+            (Parameter("mass", "kg/kg·m²", "apparent mass M (kg axially, kg·m² in torsion)", (1e-12, 1e4)),),
             "Mass between the rubber and the force sensor (fixture, part of the rubber) is "
             "accelerated with the drive; its inertial force adds to the rubber's.",
             "Measured stiffness falls below the model more and more at high frequency, as ω², "
@@ -86,7 +90,7 @@ EFFECTS: dict[str, Effect] = {
         Effect(
             "viscous",
             "Integer-order viscous damping",
-            (Parameter("viscosity", "Pa·s", "viscous coefficient c (σ = c dε/dt)"),),
+            (Parameter("viscosity", "Pa·s", "viscous coefficient c (σ = c dε/dt)", (1e-3, 1e9)),),
             "A damping stress proportional to the strain rate, as from a fluid or a very "
             "fast relaxation mechanism.",
             "The loss factor grows in proportion to frequency at every amplitude, more than "
@@ -95,7 +99,7 @@ EFFECTS: dict[str, Effect] = {
         Effect(
             "strain_stiffening",
             "Elastic stiffening at large strain",
-            (Parameter("stiffening", "–", "β in σ_el = 2µε(1 + βε²)"),),
+            (Parameter("stiffening", "–", "β in σ_el = 2µε(1 + βε²)", (1e-6, 1e9)),),
             "The rubber network stiffens as its chains approach their full extension.",
             "At the largest amplitudes the stiffness is higher than the model, growing with "
             "the amplitude squared, at every frequency; the loss factor drops there.",
@@ -103,12 +107,13 @@ EFFECTS: dict[str, Effect] = {
         Effect(
             "rate_amplitude_coupling",
             "Friction that stiffens with rate",
-            (Parameter("rate_exponent", "–", "γ in µ_f · (f / 10 Hz)^γ"),),
+            (Parameter("rate_exponent", "–", "γ in µ_f · (f / 10 Hz)^γ", (0.0, 2.0), log=False),),
             "The filler network's friction is not quite rate independent: it stiffens at "
             "higher rates, which the separable model (friction independent of frequency) "
             "cannot show.",
             "The amplitude dependence is stronger at high frequency than at low: the gap "
             "between small- and large-amplitude stiffness grows with frequency.",
+            requires=("friction",),
         ),
         Effect(
             "nonuniform_strain",
@@ -118,15 +123,19 @@ EFFECTS: dict[str, Effect] = {
             "torsion, 1/r axially), so each layer softens by its own amplitude.",
             "At amplitudes in the knee of the Fletcher–Gent curve, the measured stiffness "
             "softens more gradually with amplitude than the single equivalent strain gives.",
+            requires=("friction", "strain_stiffening"),
+            excludes=("wave_effects",),
         ),
         Effect(
             "wave_effects",
             "Standing shear waves in the rubber",
-            (Parameter("density", "kg/m³", "rubber density ρ"),),
+            (Parameter("density", "kg/m³", "rubber density ρ (fitted within 300–5000, rubbers' range)",
+                       (300.0, 5000.0)),),
             "The rubber's own mass: at high frequency shear waves stand across the rubber "
             "and the stiffness shows resonances.",
-            "Stiffness departs from the model at the highest frequencies, growing steeply "
-            "(towards a resonance), the same at every amplitude.",
+            "Stiffness rises above the model at the highest frequencies, steeply (towards a "
+            "resonance), the same at every amplitude.",
+            excludes=("nonuniform_strain",),
         ),
     )
 }

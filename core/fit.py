@@ -21,6 +21,7 @@ of the fitted (log) parameters, which the monotone transforms leave unchanged to
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,7 +29,8 @@ from scipy.optimize import least_squares
 
 from .bushing import loop_force, stiffness_points
 from .data import MeasuredLoop, MeasuredStiffness
-from .design import Design, Material, as_dict
+from .design import Design, as_dict
+from .effects import EFFECTS, Parameter
 
 PARAMETERS = (
     "shear_modulus",
@@ -37,16 +39,41 @@ PARAMETERS = (
     "friction_stress_max",
     "friction_strain_half",
 )
-LOG = {"shear_modulus", "fractional_coefficient", "friction_stress_max", "friction_strain_half"}
-ORDER_BOUNDS = (1e-3, 1.0)
-# bounds of the fitted values, far wider than any rubber: they keep the search finite
-VALUE_BOUNDS = {
-    "shear_modulus": (1e2, 1e11),
-    "fractional_coefficient": (1e-2, 1e11),
-    "fractional_order": ORDER_BOUNDS,
-    "friction_stress_max": (1e-3, 1e9),
-    "friction_strain_half": (1e-9, 10.0),
-}
+# µ's fitting range, far wider than any rubber (it keeps the search finite); the other
+# parameters carry theirs in the effect library
+SHEAR_MODULUS = Parameter("shear_modulus", "Pa", "shear modulus µ", (1e2, 1e11))
+
+
+def parameter(name: str) -> Parameter:
+    """The fitting range and scale of a parameter: a material name, or ``effect_id.name``."""
+    if name == "shear_modulus":
+        return SHEAR_MODULUS
+    eid, _, pname = name.rpartition(".")
+    owners = [EFFECTS[eid]] if eid in EFFECTS else [] if eid else [EFFECTS["friction"], EFFECTS["fractional"]]
+    for effect in owners:
+        for p in effect.parameters:
+            if p.name == pname:
+                return p
+    raise ValueError(f"unknown parameter {name!r}")
+
+
+def parameter_values(design: Design) -> dict[str, float]:
+    """Every parameter of a design by its fitting name: the material's, then ``effect.name``."""
+    values = as_dict(design.material)
+    for eid, params in design.effects:
+        values.update({f"{eid}.{p}": v for p, v in params})
+    return values
+
+
+def with_values(design: Design, values: dict[str, float]) -> Design:
+    """``design`` with parameters (fitting names, as :func:`parameter_values`) replaced."""
+    material = {k: v for k, v in values.items() if "." not in k}
+    effects = design.effect_parameters
+    for k, v in values.items():
+        if "." in k:
+            eid, _, p = k.rpartition(".")
+            effects.setdefault(eid, {})[p] = v
+    return design.replace(**material, effects=effects)
 
 
 def gap(model: np.ndarray, data: np.ndarray) -> float:
@@ -88,12 +115,14 @@ class FitResult:
 
 
 class _Problem:
-    """Residuals of a design's material against measured data, over a subset of parameters."""
+    """Residuals of a design against measured data, over a subset of its parameters (material
+    names, or ``effect.name`` for the parameters of its effects)."""
 
     def __init__(self, design: Design, data: MeasuredStiffness | None, loop: MeasuredLoop | None,
                  free: tuple[str, ...]):
         self.design, self.data, self.loop, self.free = design, data, loop, free
-        self.base = as_dict(design.material)
+        self.base = parameter_values(design)
+        self.specs = [parameter(p) for p in free]
         if loop is not None:
             self.loop_f, self.loop_amp, self.loop_phase = loop.harmonic()
             self.loop_force = loop.force - np.mean(loop.force)
@@ -102,23 +131,22 @@ class _Problem:
             # the loop weighs as much as the stiffness points (or as one point per sample alone)
             self.loop_weight = math.sqrt(max(n_k, loop.force.size) / loop.force.size)
 
-    def to_theta(self, material: dict) -> np.ndarray:
-        return np.array([math.log(material[p]) if p in LOG else material[p] for p in self.free])
+    def to_theta(self, values: dict) -> np.ndarray:
+        return np.array([math.log(values[p]) if s.log else values[p] for p, s in zip(self.free, self.specs)])
 
-    def material(self, theta) -> Material:
-        values = dict(self.base)
-        for p, t in zip(self.free, theta):
-            values[p] = math.exp(t) if p in LOG else float(t)
-        return Material(**values)
+    def values(self, theta) -> dict[str, float]:
+        return {p: math.exp(t) if s.log else float(t) for p, s, t in zip(self.free, self.specs, theta)}
+
+    def model(self, theta) -> Design:
+        return with_values(self.design, self.values(theta))
 
     def bounds(self):
-        lo = [math.log(VALUE_BOUNDS[p][0]) if p in LOG else VALUE_BOUNDS[p][0] for p in self.free]
-        hi = [math.log(VALUE_BOUNDS[p][1]) if p in LOG else VALUE_BOUNDS[p][1] for p in self.free]
+        lo = [math.log(s.bounds[0]) if s.log else s.bounds[0] for s in self.specs]
+        hi = [math.log(s.bounds[1]) if s.log else s.bounds[1] for s in self.specs]
         return lo, hi
 
     def residuals(self, theta) -> np.ndarray:
-        design = Design(self.design.mode, self.design.geometry, self.material(theta),
-                        effects=self.design.effects)
+        design = self.model(theta)
         parts = []
         if self.data is not None:
             k = stiffness_points(design, self.data.frequency_hz, self.data.amplitude)
@@ -140,11 +168,10 @@ def _uncertainties(problem: _Problem, sol) -> tuple[dict, dict]:
     except np.linalg.LinAlgError:
         cov = s2 * np.linalg.pinv(jtj)
     sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    material = problem.material(sol.x)
+    values = problem.values(sol.x)
     errors = {}
-    for i, name in enumerate(problem.free):
-        value = getattr(material, name)
-        errors[name] = float(value * sd[i] if name in LOG else sd[i])  # delta method
+    for i, (name, spec) in enumerate(zip(problem.free, problem.specs)):
+        errors[name] = float(values[name] * sd[i] if spec.log else sd[i])  # delta method
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(sd, sd)
     correlation = {a: {b: float(np.round(corr[i, j], 12)) for j, b in enumerate(problem.free)}
@@ -165,12 +192,14 @@ def _starts(problem: _Problem, n: int, seed: int = 0) -> list[np.ndarray]:
         cols.append(rng.permutation((np.arange(n - 1) + rng.random(n - 1)) / (n - 1)))
     for k in range(n - 1):
         theta = []
-        for j, name in enumerate(problem.free):
+        for j, (name, spec) in enumerate(zip(problem.free, problem.specs)):
             u = cols[j][k]
             if name == "fractional_order":
                 theta.append(0.05 + 0.75 * u)
-            else:
+            elif spec.log:
                 theta.append(first[j] + math.log(10.0) * (2 * u - 1))
+            else:
+                theta.append(spec.bounds[0] + (spec.bounds[1] - spec.bounds[0]) * u)
         starts.append(np.array(theta))
     return starts
 
@@ -195,8 +224,8 @@ def _solve(problem: _Problem, starts: list[np.ndarray]):
 def _result(problem: _Problem, sol, method: str, starts: int, design: Design, errors=None, corr=None):
     if errors is None:
         errors, corr = _uncertainties(problem, sol)
-    fitted = Design(design.mode, design.geometry, problem.material(sol.x), name=design.name and f"{design.name} (fitted)",
-                    effects=design.effects)
+    fitted = problem.model(sol.x)
+    fitted = fitted.replace(name=design.name and f"{design.name} (fitted)")
     g = float("nan")
     if problem.data is not None:
         g = gap(stiffness_points(fitted, problem.data.frequency_hz, problem.data.amplitude),
@@ -210,11 +239,16 @@ def _result(problem: _Problem, sol, method: str, starts: int, design: Design, er
 
 
 def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: MeasuredLoop | None = None,
-               *, starts: int = 8, free: tuple[str, ...] = PARAMETERS, seed: int = 0) -> FitResult:
-    """Fit the material parameters ``free`` of ``design`` to all the data at once.
+               *, starts: int = 8, free: tuple[str, ...] = PARAMETERS, seed: int = 0,
+               initial: Sequence[Mapping[str, float]] = ()) -> FitResult:
+    """Fit the parameters ``free`` of ``design`` to all the data at once.
 
     ``design`` gives the geometry, the mode and the starting values; ``data`` measured
-    stiffness, ``loop`` a measured loop (at least one of the two). Returns a :class:`FitResult`.
+    stiffness, ``loop`` a measured loop (at least one of the two). ``free`` names material
+    parameters or effect parameters as ``effect_id.name``. The search starts from the design's
+    values and ``starts − 1`` seeded points around them, or, if ``initial`` is given, from those
+    points (mappings of some free parameters' values, the rest the design's).
+    Returns a :class:`FitResult`.
     """
     if data is None and loop is None:
         raise ValueError("give measured stiffness, a measured loop, or both")
@@ -222,8 +256,12 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     if n <= len(free):
         raise ValueError(f"{n // 2} points cannot determine {len(free)} parameters")
     problem = _Problem(design, data, loop, tuple(free))
-    sol = _solve(problem, _starts(problem, starts, seed))
-    return _result(problem, sol, "global", starts, design)
+    if initial:
+        points = [problem.to_theta({**problem.base, **dict(v)}) for v in initial]
+    else:
+        points = _starts(problem, starts, seed)
+    sol = _solve(problem, points)
+    return _result(problem, sol, "global", len(points), design)
 
 
 def fit_two_step(design: Design, loop: MeasuredLoop, sweep: MeasuredStiffness,
