@@ -17,6 +17,7 @@ import numpy as np
 from bokeh import events
 from bokeh.core.properties import value
 from bokeh.models import (
+    ColorBar,
     ColumnDataSource,
     DataRange1d,
     HoverTool,
@@ -52,6 +53,7 @@ class Figure:
         y: Axis,
         *,
         x_log: bool = False,
+        y_log: bool = False,
         x_range=None,
         y_range=None,
         height: int = 300,
@@ -64,6 +66,7 @@ class Figure:
         self.fig = figure(
             title=title,
             x_axis_type="log" if x_log else "linear",
+            y_axis_type="log" if y_log else "linear",
             x_range=x_range if x_range is not None else DataRange1d(),
             y_range=y_range if y_range is not None else DataRange1d(),
             height=height,
@@ -114,6 +117,20 @@ class Figure:
         """Markers (measured data)."""
         return self._glyph(key, ("x", "y"), lambda src: self.fig.scatter("x", "y", source=src, **style), label)
 
+    def coloured_points(self, key: str, **style):
+        """Markers each with its own colour (a ``color`` column), e.g. one colour per group."""
+        return self._glyph(key, ("x", "y", "color"),
+                           lambda src: self.fig.scatter("x", "y", source=src, color="color", **style), None)
+
+    def mapped_points(self, key: str, mapper, title: str, **style):
+        """Markers coloured by a ``value`` column through a Bokeh colour mapper, with a colour bar."""
+        renderer = self._glyph(key, ("x", "y", "value"), lambda src: self.fig.scatter(
+            "x", "y", source=src, fill_color={"field": "value", "transform": mapper}, line_color="#777777",
+            line_width=0.5, **style), None)
+        self.fig.add_layout(ColorBar(color_mapper=mapper, title=title, width=10, title_text_font_size="11px",
+                                     major_label_text_font_size="10px"), "right")
+        return renderer
+
     def band(self, key: str, label: str | None = None, **style):
         return self._glyph(key, ("x", "y1", "y2"),
                            lambda src: self.fig.varea("x", "y1", "y2", source=src, **style), label)
@@ -143,7 +160,9 @@ class Figure:
                 item.label = value(label)
 
     def set(self, key: str, **columns):
-        self.sources[key].data = {k: np.asarray(v, dtype=float) for k, v in columns.items()}
+        """Replace one glyph's data (numbers; a ``color`` column stays text)."""
+        self.sources[key].data = {k: list(v) if k == "color" else np.asarray(v, dtype=float)
+                                  for k, v in columns.items()}
 
     def clear(self, key: str):
         self.set(key, **{k: [] for k in self.sources[key].data})

@@ -8,6 +8,8 @@ import sys
 
 import panel as pn
 
+from .diagnosis import DiagnosisView
+from .diagnosis_state import DiagnosisState
 from .measured import MeasuredView
 from .state import ExplorerState
 from .views import (
@@ -53,6 +55,7 @@ class App(pn.viewable.Viewer):
         self.slices = SlicesView(self.state)
         self.teaching = TeachingView(self.state)
         self.measured = MeasuredView(self.state)
+        self.diagnosis = DiagnosisView(DiagnosisState(self.state))
         self.compare = CompareView(self.state)
         self.export = ExportView(self.state)
         self.tabs = pn.Tabs(
@@ -60,6 +63,7 @@ class App(pn.viewable.Viewer):
             ("Slices", self.slices),
             ("Fletcher–Gent, branch by branch", self.teaching),
             ("Measured data and fit", self.measured),
+            ("Find the missing effect", self.diagnosis),
             ("About", pn.pane.Markdown(ABOUT, sizing_mode="stretch_width")),
             dynamic=True,
             sizing_mode="stretch_width",

@@ -14,7 +14,14 @@ import numpy as np
 import param
 
 from core import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material
-from core.bushing import branch_stiffness, loop, stiffness, stiffness_points, strain_factor
+from core.bushing import (
+    branch_stiffness,
+    loop,
+    material_model,
+    stiffness,
+    stiffness_points,
+    strain_factor,
+)
 from core.data import DataError, MeasuredLoop, MeasuredStiffness, parse_loop, parse_stiffness
 from core.design import as_dict
 from core.fit import FitResult, fit_global, fit_two_step, gap
@@ -368,7 +375,7 @@ class ExplorerState(param.Parameterized):
 
     def hysteresis_loop(self, design: Design | None = None, amplitude=None, points: int = 200):
         """One steady period at the operating point (or ``amplitude``), display units."""
-        design = design or self.design
+        design = material_model(design or self.design)  # stiffness-level effects have no branches
         x = self.amplitude if amplitude is None else amplitude
         lp = loop(design, self.frequency_hz, float(self._si_amplitude(x)), points)
         scale = 1.0 / AMPLITUDE_DISPLAY[design.mode][1]
@@ -389,7 +396,7 @@ class ExplorerState(param.Parameterized):
                "loss_factor_diff_pct": {}}
         for s in SLICES:
             try:
-                r = stiffness(self.design, self.frequency_hz, self._si_amplitude(x), slices=s)
+                r = stiffness(material_model(self.design), self.frequency_hz, self._si_amplitude(x), slices=s)
             except ConvergenceError:
                 continue  # said in the view; never an unconverged number
             out["magnitude"][s] = self._stiffness_display(r.magnitude[:, 0])
@@ -405,7 +412,7 @@ class ExplorerState(param.Parameterized):
         """How the elastic, viscoelastic and friction branches make up K against amplitude at
         the operating frequency: their shares of Re K and of the loss factor."""
         x = self.amplitude_grid(n)
-        parts = {k: v[:, 0] for k, v in branch_stiffness(self.design, self.frequency_hz, self._si_amplitude(x)).items()}
+        parts = {k: v[:, 0] for k, v in branch_stiffness(material_model(self.design), self.frequency_hz, self._si_amplitude(x)).items()}
         total = sum(parts.values())
         re = total.real
         return {

@@ -15,6 +15,7 @@ import numpy as np
 import panel as pn
 from bokeh.models import CustomJSTickFormatter, DataRange1d
 
+from core.bushing import STRUCTURAL_EFFECTS
 from core.design import dumps_design
 
 from . import plots
@@ -590,7 +591,12 @@ def status_banner(state: ExplorerState):
             )
         effects = ", ".join(design.effect_parameters) if design.effects else ""
         name = design.name or "Custom design"
-        return f"<b>{name}</b>, {design.mode}" + (f"; effects: {effects}" if effects else "")
+        text = f"<b>{name}</b>, {design.mode}" + (f"; effects: {effects}" if effects else "")
+        structural = [e for e in design.effect_parameters if e in STRUCTURAL_EFFECTS]
+        if structural:
+            text += (f" ({', '.join(structural)} act on the stiffness plots; the loop, slices and "
+                     "branches show the material model)")
+        return text
 
     return pn.pane.HTML(pn.bind(render, state.param.errors, state.param.design),
                         sizing_mode="stretch_width", margin=(4, 10))

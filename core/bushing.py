@@ -387,8 +387,18 @@ def loop_force(design: Design, frequency_hz: float, amplitude: float, phase):
     return scale * el, scale * fr, scale * fric
 
 
+STRUCTURAL_EFFECTS = ("inertia", "nonuniform_strain", "wave_effects")
+
+
+def material_model(design: Design) -> Design:
+    """``design`` without its stiffness-level effects (:data:`STRUCTURAL_EFFECTS`): the material
+    model with its material-level effects, for loops and branch-by-branch views."""
+    kept = {eid: p for eid, p in design.effect_parameters.items() if eid not in STRUCTURAL_EFFECTS}
+    return design if len(kept) == len(design.effects) else design.replace(effects=kept)
+
+
 def _refuse_structural_effects(design: Design, what: str, allowed=()):
-    for eid in ("inertia", "nonuniform_strain", "wave_effects"):
+    for eid in STRUCTURAL_EFFECTS:
         if eid in design.effect_parameters and eid not in allowed:
             raise ValueError(
                 f"effects.{eid}: {what} is computed from the material branches; it is not "

@@ -7,8 +7,6 @@ cannot converge exits with status 1 and one line; no traceback is ever printed.
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import json
 import math
 import sys
@@ -17,7 +15,7 @@ from contextlib import contextmanager
 import numpy as np
 
 from .bushing import loop, stiffness
-from .data import DataError
+from .data import DataError, csv_text
 from .design import DesignError, read_design
 from .material import ConvergenceError
 
@@ -193,12 +191,7 @@ def _write_text(text: str, output: str | None) -> None:
 
 
 def _write_csv(columns: dict[str, np.ndarray], output: str | None) -> None:
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(columns)
-    for row in zip(*columns.values()):
-        writer.writerow([NUMBER_FORMAT.format(v) for v in row])
-    _write_text(buf.getvalue(), output)
+    _write_text(csv_text(columns, NUMBER_FORMAT), output)
 
 
 def _cmd_stiffness(args) -> None:

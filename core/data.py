@@ -71,6 +71,16 @@ class MeasuredStiffness(ComplexStiffness):
         return text
 
 
+def csv_text(columns: dict[str, np.ndarray], number_format: str = "{:.12g}") -> str:
+    """CSV text with a header row of the column names and one row per index (SI numbers)."""
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(columns)
+    for row in zip(*columns.values()):
+        writer.writerow([number_format.format(v) for v in row])
+    return buf.getvalue()
+
+
 @dataclass(frozen=True, eq=False)
 class MeasuredLoop:
     """A measured steady harmonic test: displacement (m or rad) and force (N or N·m) in time."""

@@ -7,11 +7,13 @@ deviation ``noise`` in its real and imaginary parts; a loop's force gets Gaussia
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .bushing import loop_force, stiffness_points
 from .data import MeasuredLoop, MeasuredStiffness
-from .design import Design
+from .design import PAPER_B, TABLE_1, Design
 
 
 def synthetic_stiffness(design: Design, frequency_hz, amplitude, *, noise: float = 0.005,
@@ -51,3 +53,41 @@ def paper_b_example(design: Design):
     data = synthetic_stiffness(design, np.linspace(1, 100, 30), PAPER_B_AMPLITUDES, seed=12345)
     loop = synthetic_loop(design, 0.1, 1e-3, seed=12346)
     return data, loop
+
+
+@dataclass(frozen=True)
+class Mystery:
+    """Data with a hidden effect for the discrepancy workflow's demo: the truth is ``hidden``
+    (effect id → parameters; {} for none) and, for a baseline without a branch, ``baseline``."""
+
+    design: Design  # the bushing as the user gets it: geometry and starting material, no effects
+    hidden: dict
+    baseline: tuple[str, ...]
+    frequency_hz: tuple[float, ...]
+    amplitude: tuple[float, ...]
+    seed: int
+
+    @property
+    def missing(self) -> list[str]:
+        """What the baseline lacks: the branches it leaves out, then the hidden effects."""
+        return [b for b in ("elastic", "fractional", "friction") if b not in self.baseline] + list(self.hidden)
+
+    def data(self) -> MeasuredStiffness:
+        return synthetic_stiffness(self.design.replace(effects=self.hidden), self.frequency_hz, self.amplitude,
+                                   noise=0.005, seed=self.seed)
+
+
+_SWEEP = tuple(np.linspace(1.0, 100.0, 30))
+_ALL = ("elastic", "fractional", "friction")
+MYSTERIES = (
+    Mystery(PAPER_B, {"inertia": {"mass": 0.5}}, _ALL, _SWEEP, PAPER_B_AMPLITUDES, 101),
+    Mystery(PAPER_B, {}, ("elastic", "fractional"), _SWEEP, PAPER_B_AMPLITUDES, 102),
+    Mystery(PAPER_B, {"rate_amplitude_coupling": {"rate_exponent": 0.05}}, _ALL, _SWEEP, PAPER_B_AMPLITUDES, 103),
+    Mystery(PAPER_B, {"wave_effects": {"density": 1150.0}}, _ALL, tuple(np.geomspace(10, 1000, 30)),
+            PAPER_B_AMPLITUDES, 104),
+    Mystery(PAPER_B, {"viscous": {"viscosity": 1000.0}, "strain_stiffening": {"stiffening": 10.0}}, _ALL,
+            _SWEEP, tuple(np.geomspace(0.05e-3, 2e-3, 5)), 105),
+    Mystery(TABLE_1, {"viscous": {"viscosity": 1000.0}}, _ALL, tuple(np.linspace(10, 100, 30)),
+            tuple(np.geomspace(1e-4, 1e-1, 5)), 106),
+    Mystery(PAPER_B, {}, _ALL, _SWEEP, PAPER_B_AMPLITUDES, 107),
+)

@@ -248,3 +248,43 @@ def test_upload_fit_and_use(page, explorer_url, tmp_path):
     wait_quiet(page)
     measured = plots(page)["|K| against frequency"]
     assert measured["points"] > 150 * 2  # curves and the 150 measured points
+
+
+def test_diagnose_a_hidden_effect_and_use_the_final_model(page, explorer_url, tmp_path):
+    import numpy as np
+
+    from core import PAPER_B
+    from core.synthetic import synthetic_stiffness
+
+    hidden = PAPER_B.replace(effects={"inertia": {"mass": 0.5}})
+    measured = tmp_path / "inertia.csv"
+    synthetic_stiffness(hidden, np.linspace(1, 100, 30), [0.013e-3, 0.04e-3, 0.1e-3, 0.17e-3, 0.35e-3],
+                        seed=3).to_csv(measured)
+    open_explorer(page, explorer_url)
+    page.get_by_text("Find the missing effect", exact=True).click()
+    page.get_by_role("button", name="Diagnose").wait_for(timeout=20000)
+    page.locator("input[type=file]").last.set_input_files(str(measured))
+    page.get_by_text("150 points").first.wait_for(timeout=10000)
+    page.get_by_role("button", name="Diagnose").click()
+    page.get_by_text("Step 1: add Apparent mass seen by the force sensor").wait_for(timeout=30000)
+    page.get_by_text("What is left is noise", exact=True).wait_for(timeout=5000)
+    wait_quiet(page)
+    shown = plots(page)
+    gaps = shown["Gap (relative RMS misfit of complex stiffness) after each step"]
+    assert gaps["points"] == 2 and len(gaps["spans"]) == 1  # baseline and + inertia; the noise line
+    assert shown["Final: |K| misfit (%)"]["points"] >= 150
+    page.get_by_role("button", name="Use the final model in the explorer").click()
+    page.get_by_text("effects: inertia").first.wait_for(timeout=10000)
+    page.get_by_text("(diagnosed)").first.wait_for(timeout=10000)
+
+
+def test_mystery_demo_reveals_its_truth(page, explorer_url):
+    open_explorer(page, explorer_url)
+    page.get_by_text("Find the missing effect", exact=True).click()
+    page.get_by_role("button", name="Load a mystery data set (demo)").click()
+    page.get_by_text("mystery data set").first.wait_for(timeout=10000)
+    page.get_by_role("button", name="Diagnose").click()
+    page.get_by_role("button", name="Reveal the truth").wait_for(timeout=30000)
+    page.get_by_role("button", name="Reveal the truth").click()
+    page.get_by_text(re.compile("Hidden in the data|Nothing was hidden")).wait_for(timeout=10000)
+    assert page.get_by_text("The diagnosis found exactly that.").count() == 1

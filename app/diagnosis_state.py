@@ -1,0 +1,165 @@
+"""State of the "Find the missing effect" tab: the data, the baseline, the diagnosis and its
+plots' data. No Panel import: the view (:mod:`app.diagnosis`) is thin."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import param
+
+from core.data import DataError, MeasuredStiffness, csv_text, parse_stiffness
+from core.diagnose import BRANCHES, Diagnosis, diagnose
+from core.effects import EFFECTS
+from core.synthetic import MYSTERIES, Mystery
+
+from .state import AMPLITUDE_DISPLAY, STIFFNESS_DISPLAY, ExplorerState
+
+
+class DiagnosisState(param.Parameterized):
+    """One session's discrepancy workflow, on the explorer's design (its geometry is known)."""
+
+    data = param.ClassSelector(class_=MeasuredStiffness, default=None, allow_None=True,
+                               doc="The measured stiffness to diagnose (SI).")
+    source = param.String(default="", doc="Where the data came from.")
+    baseline = param.ListSelector(default=list(BRANCHES), objects=list(BRANCHES), label="Baseline branches",
+                                  doc="The branches the starting model has: elastic µ, fractional m(iω)^α, "
+                                  "friction (the Fletcher–Gent effect).")
+    result = param.ClassSelector(class_=Diagnosis, default=None, allow_None=True)
+    running = param.Boolean(default=False)
+    progress = param.Number(default=0.0, bounds=(0.0, 1.0))
+    progress_message = param.String(default="")
+    message = param.String(default="", doc="What went wrong, if anything.")
+    mystery = param.ClassSelector(class_=Mystery, default=None, allow_None=True,
+                                  doc="The demo's hidden truth (shown only after the diagnosis).")
+    revealed = param.Boolean(default=False)
+
+    def __init__(self, explorer: ExplorerState, **params):
+        super().__init__(**params)
+        self.explorer = explorer
+        self._next_mystery = int(np.random.default_rng().integers(len(MYSTERIES)))
+
+    # ---- data ----------------------------------------------------------------------------------
+
+    def _set_data(self, data: MeasuredStiffness, source: str, mystery: Mystery | None = None):
+        self.param.update(data=data, source=source, result=None, message="", mystery=mystery, revealed=False)
+
+    def load_csv(self, content: bytes | str, filename: str = "stiffness file") -> bool:
+        try:
+            data = parse_stiffness(content)
+        except DataError as exc:
+            self.message = f"{filename}: {exc}"
+            return False
+        self._set_data(data, filename)
+        return True
+
+    def use_measured(self) -> bool:
+        """The stiffness loaded in the "Measured data and fit" tab."""
+        if self.explorer.measured is None:
+            self.message = "No measured stiffness is loaded in the “Measured data and fit” tab."
+            return False
+        self._set_data(self.explorer.measured, "the data of the “Measured data and fit” tab")
+        return True
+
+    def load_mystery(self):
+        """The next demo data set: its bushing goes into the explorer, its truth stays hidden."""
+        mystery = MYSTERIES[self._next_mystery % len(MYSTERIES)]
+        self._next_mystery += 1
+        self.explorer.load_design(mystery.design)
+        self.baseline = list(mystery.baseline)
+        self._set_data(mystery.data(), f"mystery data set {MYSTERIES.index(mystery) + 1} of {len(MYSTERIES)} "
+                       f"(synthetic, {mystery.design.name}, 0.5 % noise)", mystery)
+
+    # ---- the diagnosis -------------------------------------------------------------------------
+
+    def compute(self, progress=None) -> Diagnosis:
+        """Run the workflow (pure: safe in a worker thread; the view stores the result)."""
+        if self.data is None:
+            raise ValueError("load data first: a stiffness CSV, the measured data, or a mystery data set")
+        if not self.baseline:
+            raise ValueError("choose at least one baseline branch")
+        design = self.explorer.design.replace(effects={})
+        return diagnose(design, self.data, baseline=[b for b in BRANCHES if b in self.baseline], progress=progress)
+
+    def use_final(self):
+        """Take the final model into the explorer, keeping the operating point."""
+        if self.result is None:
+            return
+        amplitude, frequency = self.explorer.amplitude, self.explorer.frequency_hz
+        design = self.result.final.design
+        self.explorer.load_design(design.replace(name=f"{self.explorer.design.name or 'Design'} (diagnosed)"))
+        self.explorer.param.update(amplitude=amplitude, frequency_hz=frequency)
+
+    def truth(self) -> str:
+        """The demo's truth in words, and whether the diagnosis found it."""
+        m = self.mystery
+        if m is None:
+            return ""
+        missing = m.missing
+        if not missing:
+            said = "Nothing was hidden: the data came from the thesis model itself, with 0.5 % noise."
+        else:
+            parts = []
+            for eid in missing:
+                values = m.hidden.get(eid) or {p.name: getattr(m.design.material, p.name)
+                                               for p in EFFECTS[eid].parameters}
+                shown = ", ".join(f"{k} = {v:.4g}" for k, v in values.items())
+                parts.append(f"**{EFFECTS[eid].title}** (`{eid}`{': ' + shown if shown else ''})")
+            said = "Hidden in the data: " + " and ".join(parts) + "."
+        if self.result is not None:
+            found = sorted(self.result.added) == sorted(missing)
+            said += " The diagnosis " + ("found exactly that." if found else
+                                         f"named {', '.join(self.result.added) or 'nothing'}.")
+        return said
+
+    # ---- data for the plots --------------------------------------------------------------------
+
+    def gap_stages(self) -> dict:
+        """The gap after each stage: baseline, then each added effect."""
+        r = self.result
+        labels = ["baseline"] + [f"+ {s.effect}" for s in r.steps]
+        gaps = [r.baseline.gap] + [s.gap_after for s in r.steps]
+        return {"stage": labels, "gap": np.array(gaps), "noise": r.noise_gap}
+
+    def misfit(self, which: str) -> dict:
+        """Model − data over the (frequency, amplitude) plane: |K| in %, loss factor."""
+        r = self.result
+        k = (r.baseline if which == "baseline" else r.final).stiffness
+        d = r.data
+        return {
+            "frequency_hz": d.frequency_hz,
+            "amplitude": d.amplitude / AMPLITUDE_DISPLAY[r.final.design.mode][1],
+            "magnitude_pct": 100 * (np.abs(k) / d.magnitude - 1),
+            "loss_factor": k.imag / k.real - d.loss_factor,
+        }
+
+    def curves(self) -> dict:
+        """Data and both models against frequency, one group per measured amplitude (the most
+        populated five), display units."""
+        r = self.result
+        d = r.data
+        values, counts = np.unique(d.amplitude, return_counts=True)
+        chosen = np.sort(values[np.argsort(-counts, kind="stable")][:5])
+        groups = []
+        mode = r.final.design.mode
+        x_unit, k_unit = AMPLITUDE_DISPLAY[mode][1], STIFFNESS_DISPLAY[mode][1]
+        for amp in chosen:
+            sel = np.flatnonzero(d.amplitude == amp)
+            sel = sel[np.argsort(d.frequency_hz[sel])]
+            kb, kf, kd = r.baseline.stiffness[sel], r.final.stiffness[sel], d.stiffness[sel]
+            groups.append({
+                "amplitude": float(amp / x_unit),
+                "frequency_hz": d.frequency_hz[sel],
+                "data": (np.abs(kd) / k_unit, kd.imag / kd.real),
+                "baseline": (np.abs(kb) / k_unit, kb.imag / kb.real),
+                "final": (np.abs(kf) / k_unit, kf.imag / kf.real),
+            })
+        return {"groups": groups}
+
+    # ---- downloads -----------------------------------------------------------------------------
+
+    def report_json(self) -> str:
+        return json.dumps(self.result.report(), indent=2, allow_nan=False) + "\n" if self.result else ""
+
+    def predictions_csv(self) -> str:
+        return csv_text(self.result.predictions()) if self.result is not None else ""

@@ -1,0 +1,136 @@
+"""The "Find the missing effect" tab without a browser: the data its plots hold against the core."""
+
+import asyncio
+import csv
+import io
+import itertools
+import json
+
+import numpy as np
+import pytest
+
+from app.main import App
+from core import PAPER_B, stiffness, stiffness_points
+from core.synthetic import MYSTERIES, synthetic_stiffness
+
+F = np.linspace(1, 100, 30)
+AMPS = (0.013e-3, 0.04e-3, 0.1e-3, 0.17e-3, 0.35e-3)
+
+
+@pytest.fixture
+def app():
+    return App()
+
+
+def inertia_csv() -> str:
+    return synthetic_stiffness(PAPER_B.replace(effects={"inertia": {"mass": 0.5}}), F, AMPS, seed=3).to_csv()
+
+
+def run(app):
+    asyncio.run(app.diagnosis._run(None))
+
+
+def test_every_mystery_is_diagnosed_right():
+    """The demo's data sets: the workflow finds what each hides (and nothing where nothing is)."""
+    from core.diagnose import diagnose
+
+    for m in MYSTERIES:
+        result = diagnose(m.design, m.data(), baseline=m.baseline, held_out=False)
+        assert sorted(result.added) == sorted(m.missing), m.missing
+        assert not result.unexplained
+
+
+def test_a_diagnosis_in_the_tab_holds_the_core_numbers(app):
+    view, state = app.diagnosis, app.diagnosis.state
+    assert view.run.disabled  # nothing to diagnose yet
+    assert state.load_csv(inertia_csv(), "inertia.csv")
+    assert not view.run.disabled and "150 points" in view.source.object
+    run(app)
+    r = state.result
+    assert r.added == ["inertia"] and state.message == "" and not state.running
+    assert "Step 1: add Apparent mass seen by the force sensor" in view.report.object
+    assert "What is left is noise" in view.report.object
+    # the gap bars: the baseline's and after each step; the noise line
+    assert list(view.gap_source.data["stage"]) == ["baseline", "+ inertia"]
+    np.testing.assert_allclose(view.gap_source.data["gap"], [r.baseline.gap, r.steps[0].gap_after])
+    assert view.noise_line.location == pytest.approx(r.noise_gap)
+    # the final model's curve at 0.1 mm is the core's stiffness of the final design, in kN/mm
+    fig = view.curve_figs["magnitude"]
+    xs, ys = fig.sources["final"].data["xs"], fig.sources["final"].data["ys"]
+    k = stiffness_points(r.final.design, xs[2], 0.1e-3)
+    np.testing.assert_allclose(ys[2], np.abs(k) / 1e6, rtol=1e-12)
+    # the misfit map: model − data in % of |K|
+    m = view.maps[("final", "magnitude")].sources["misfit"].data
+    d = state.data
+    expected = 100 * (np.abs(stiffness_points(r.final.design, d.frequency_hz, d.amplitude)) / d.magnitude - 1)
+    np.testing.assert_allclose(m["value"], expected, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(m["y"], d.amplitude * 1e3)
+    # the downloads are the command line's report and predictions
+    assert json.loads(state.report_json()) == json.loads(json.dumps(r.report()))
+    rows = list(csv.reader(io.StringIO(state.predictions_csv())))
+    assert rows[0][-2:] == ["final_magnitude", "final_loss_factor"] and len(rows) == 151
+
+
+def test_the_final_model_goes_into_the_explorer(app):
+    state = app.diagnosis.state
+    state.load_csv(inertia_csv())
+    run(app)
+    f_op, x_op = app.state.frequency_hz, app.state.amplitude
+    state.use_final()
+    design = app.state.design
+    assert design.effect_parameters["inertia"]["mass"] == pytest.approx(
+        state.result.final.design.effect_parameters["inertia"]["mass"])
+    assert (app.state.frequency_hz, app.state.amplitude) == (f_op, x_op)
+    # every explorer plot still draws: |K| with the inertia, the loop from the material model
+    x, y = (np.asarray(app.plots.figures[("magnitude", "frequency")].sources["operating"].data[c])
+            for c in ("x", "y"))
+    expected = stiffness(design, x, app.state.amplitude * 1e-3).magnitude[0] / 1e6
+    np.testing.assert_allclose(y, expected, rtol=1e-9)
+    loop_x = app.plots.loop.sources["total"].data["x"]
+    assert len(loop_x) > 0
+    assert "inertia act on the stiffness plots" in app.template().main[0].object
+
+
+def test_the_mystery_demo_hides_then_reveals_the_truth(app):
+    view, state = app.diagnosis, app.diagnosis.state
+    state._next_mystery = 1  # the teaching case: no friction in the baseline
+    state.load_mystery()
+    assert state.baseline == ["elastic", "fractional"]
+    assert app.state.design.name == PAPER_B.name
+    assert "mystery" in view.source.object and view.truth.object == ""
+    run(app)
+    assert state.result.added == ["friction"]
+    assert view.reveal.visible and view.truth.object == ""  # not before it is asked for
+    state.revealed = True
+    assert "Amplitude dependence (Fletcher–Gent effect)" in view.truth.object
+    assert "found exactly that" in view.truth.object
+    assert not view.reveal.visible
+
+
+def test_bad_input_leaves_a_message_and_the_session_going(app):
+    view, state = app.diagnosis, app.diagnosis.state
+    assert not state.load_csv(b"frequency_hz,amplitude,magnitude,loss_factor\n10,1e-4,-5,0.1\n", "bad.csv")
+    assert "bad.csv" in view.message.object and state.data is None
+    assert not state.use_measured()
+    assert "No measured stiffness" in view.message.object
+    state.load_csv(inertia_csv())
+    state.baseline = []
+    run(app)
+    assert "at least one baseline branch" in view.message.object
+    assert state.result is None and not state.running
+    # too few points for the baseline: a message, no traceback
+    state.load_csv(b"frequency_hz,amplitude,magnitude,loss_factor\n10,1e-4,4e6,0.1\n20,1e-4,4.1e6,0.11\n")
+    state.baseline = ["elastic", "fractional", "friction"]
+    run(app)
+    assert "cannot determine" in view.message.object
+
+
+def test_progress_is_reported_while_fitting(app):
+    state = app.diagnosis.state
+    seen = []
+    state.load_csv(inertia_csv())
+    state.compute(progress=lambda f, m: seen.append((f, m)))
+    fractions = [f for f, _ in seen]
+    assert fractions[0] == 0.0 and fractions[-1] == 1.0
+    assert all(b >= a for a, b in itertools.pairwise(fractions))  # never backwards
+    assert any("apparent mass" in m for _, m in seen)
