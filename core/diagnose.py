@@ -56,7 +56,9 @@ BIC_THRESHOLD = 10.0
 EXPLAINED_FRACTION = 0.8  # an effect is named when it explains 80 % of the misfit above the noise
 NOISE_TOLERANCE = 0.15  # … or leaves no more than 15 % of the noise's variance (its estimate's spread)
 NOISE_RATIO = 1.3  # a mean squared misfit above 1.3 × the noise's is "above the noise"
-PAIR_POOL = 4  # pairs are sought among the four best single candidates
+PAIR_POOL = 4
+MAX_FOLDS, HELD_OUT_BANDS = 12, 5  # held-out folds: single values up to 12, else 5 bands
+PRECISION = 1e-6  # relative misfits below this are numerical, not measured  # pairs are sought among the four best single candidates
 GRID_1D, GRID_2D = 16, 9  # starting-value grids of a candidate's parameters
 BASELINE_STARTS = 8
 
@@ -128,15 +130,19 @@ def relative_residual(model_k: np.ndarray, data: MeasuredStiffness) -> np.ndarra
 
 
 def bic(residual: np.ndarray, n_parameters: int) -> float:
-    """BIC over the real and imaginary parts of the residual."""
+    """BIC over the real and imaginary parts of the residual. A misfit below
+    :data:`PRECISION` (relative) counts as none: the models are computed to about 1e-11, and
+    differences below that are the optimiser's, not the data's."""
     n = 2 * residual.size
     rss = float(np.sum(np.abs(residual) ** 2))
-    return n * math.log(max(rss, 1e-300) / n) + n_parameters * math.log(n)
+    return n * math.log(max(rss / n, PRECISION**2)) + n_parameters * math.log(n)
 
 
 def _runs(data: MeasuredStiffness):
     """Index triples (i, j, k) of neighbours along ln f at one amplitude and along ln amplitude
-    at one frequency, with their log coordinates."""
+    at one frequency, with their log coordinates. Data on no such lines (scattered points) fall
+    back on each point's two nearest neighbours in (ln f, ln amplitude), scaled to their ranges,
+    weighted equally."""
     lf, la = np.log(data.frequency_hz), np.log(data.amplitude)
     triples = []
     for along, across in ((lf, la), (la, lf)):
@@ -148,12 +154,18 @@ def _runs(data: MeasuredStiffness):
             for n in range(1, idx.size - 1):
                 if x[n + 1] > x[n - 1]:
                     triples.append((idx[n - 1], idx[n], idx[n + 1], x[n - 1], x[n], x[n + 1]))
-    return triples
+    if triples or lf.size < 3:
+        return triples
+    pts = np.column_stack([(v - v.min()) / (np.ptp(v) or 1.0) for v in (lf, la)])
+    dist = np.linalg.norm(pts[:, None, :] - pts[None, :, :], axis=-1)
+    np.fill_diagonal(dist, np.inf)
+    near = np.argsort(dist, axis=1)[:, :2]
+    return [(int(a), j, int(b), 0.0, 1.0, 2.0) for j, (a, b) in enumerate(near)]
 
 
 def noise_variance(residual: np.ndarray, data: MeasuredStiffness, runs=None) -> float | None:
-    """Complex noise variance s² (E|n|²) estimated from the residual's roughness; ``None`` when
-    the data have no run of three points to judge it by."""
+    """Complex noise variance s² (E|n|²) estimated from the residual's roughness (at least
+    :data:`PRECISION`²); ``None`` when the data have no run of three points to judge it by."""
     runs = _runs(data) if runs is None else runs
     if not runs:
         return None
@@ -162,7 +174,7 @@ def noise_variance(residual: np.ndarray, data: MeasuredStiffness, runs=None) -> 
     w0 = (x2 - x1) / (x2 - x0)
     w2 = (x1 - x0) / (x2 - x0)
     e = residual[j] - (w0 * residual[i] + w2 * residual[k])
-    return float(np.mean(np.abs(e) ** 2 / (1.0 + w0**2 + w2**2)))
+    return max(float(np.mean(np.abs(e) ** 2 / (1.0 + w0**2 + w2**2))), PRECISION**2)
 
 
 # --------------------------------------------------------------------------------------------
@@ -478,14 +490,22 @@ def _explains(before: Fitted, after: Fitted, noise: float | None) -> tuple[bool,
 
 def _held_out(data: MeasuredStiffness, fits: dict[str, Fitted]) -> dict:
     """Leave one amplitude out (or, with fewer than three amplitudes, one frequency): refit each
-    model on the rest from its fitted values, predict the points left out; the gap over them."""
-    for axis, values in (("amplitude", data.amplitude), ("frequency_hz", data.frequency_hz)):
+    model on the rest from its fitted values, predict the points left out; the gap over them.
+    With more than :data:`MAX_FOLDS` distinct values (scattered data), bands of equal count are
+    left out instead of single values."""
+    for axis, values in (("amplitude", data.amplitude), ("frequency", data.frequency_hz)):
         levels = np.unique(values)
         if levels.size >= 3:
             break
     else:
         return {}
-    out: dict = {"left_out": f"one {axis.replace('_hz', '')} at a time", "folds": int(levels.size)}
+    what = f"one {axis} at a time"
+    if levels.size > MAX_FOLDS:
+        edges = np.quantile(values, np.linspace(0, 1, HELD_OUT_BANDS + 1))
+        values = np.clip(np.searchsorted(edges, values, side="right") - 1, 0, HELD_OUT_BANDS - 1)
+        levels = np.unique(values)
+        what = f"one {axis} band of {HELD_OUT_BANDS} at a time"
+    out: dict = {"left_out": what, "folds": int(levels.size)}
     done: dict[int, float] = {}
     for label, fitted in fits.items():
         if id(fitted) in done:  # the same model (nothing was added): the same figure

@@ -275,3 +275,28 @@ def test_cli_diagnose_bad_file_is_one_line(files, capsys):
     assert exc.value.code == 2
     err = capsys.readouterr().err
     assert "line 2" in err and err.count("\n") == 1
+
+
+def test_noise_free_data_add_exactly_what_is_missing():
+    """With no noise the misfit of the right model is numerical (~1e-16): nothing spurious is
+    added on top, and nothing is called unexplained."""
+    for effects in ({}, {"inertia": {"mass": 0.5}}):
+        data = synthetic_stiffness(PAPER_B.replace(effects=effects), F_SWEEP, A_PAPER_B, noise=0.0)
+        result = diagnose(PAPER_B, data, held_out=False)
+        assert result.added == list(effects)
+        assert not result.unexplained
+        assert result.final.gap < 1e-6
+
+
+def test_scattered_points_off_any_grid():
+    """Points at random frequencies and amplitudes: the noise is judged from nearest
+    neighbours, the held-out check leaves out amplitude bands."""
+    rng = np.random.default_rng(4)
+    f = rng.uniform(1, 100, 150)
+    x = np.exp(rng.uniform(math.log(1e-5), math.log(4e-4), 150))
+    k = stiffness_points(PAPER_B.replace(effects={"inertia": {"mass": 0.5}}), f, x)
+    k = k * (1 + NOISE * (rng.standard_normal(150) + 1j * rng.standard_normal(150)))
+    result = diagnose(PAPER_B, MeasuredStiffness(f, x, k))
+    assert result.added == ["inertia"]
+    assert result.noise_gap == pytest.approx(NOISE_GAP, rel=0.2)
+    assert result.held_out["folds"] == 5 and result.held_out["gap_final"] < 1.2 * NOISE_GAP
