@@ -13,7 +13,7 @@ from bokeh.models import FactorRange, LinearColorMapper, Span
 from bokeh.palettes import RdBu11
 from bokeh.plotting import figure
 
-from core.diagnose import BIC_THRESHOLD, describe_fit
+from core.diagnose import BIC_THRESHOLD
 from core.effects import EFFECTS
 from core.material import ConvergenceError
 
@@ -236,7 +236,7 @@ class DiagnosisView(pn.viewable.Viewer):
         branches = ", ".join(r.baseline.model.branches)
         lines = [
             f"**Baseline** ({branches}): gap **{r.baseline.gap:.4f}**; the noise alone gives about {noise}.",
-            f"*Where it disagrees:* {describe_fit(r.baseline, r)}",
+            f"*Where it disagrees:* {r.where_baseline}",
         ]
         for n, step in enumerate(r.steps, 1):
             params = ", ".join(f"{k} = {v:.4g}" for k, v in step.parameters.items()) or "no parameters"

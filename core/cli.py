@@ -132,9 +132,7 @@ def build_parser() -> argparse.ArgumentParser:
         "design file with the fitted material and a `fit` object: standard_errors, "
         "correlation, gap.",
     )
-    ft.add_argument("measured", metavar="MEASURED.csv", help="measured stiffness (FORMATS.md)")
-    ft.add_argument("--design", required=True, metavar="DESIGN.json",
-                    help="geometry, mode and starting material")
+    _measured_arguments(ft, "geometry, mode and starting material")
     ft.add_argument("--loop", metavar="LOOP.csv", help="a measured steady loop (time_s, displacement, force)")
     ft.add_argument("-o", dest="output", metavar="FITTED.json", help="write here, not to stdout")
 
@@ -147,9 +145,7 @@ def build_parser() -> argparse.ArgumentParser:
         "report the gap before and after each step and on held-out data. The report (JSON) goes "
         "to standard output, or to --json with a summary in plain words on standard output.",
     )
-    dg.add_argument("measured", metavar="MEASURED.csv", help="measured stiffness (FORMATS.md)")
-    dg.add_argument("--design", required=True, metavar="DESIGN.json",
-                    help="geometry (known), mode and starting parameters")
+    _measured_arguments(dg, "geometry (known), mode and starting parameters")
     dg.add_argument("--baseline", default="elastic,fractional,friction", metavar="IDS",
                     help="the branches the starting model has, comma-separated from "
                     "elastic,fractional,friction (default: all three)")
@@ -168,6 +164,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="interface to listen on (default localhost; 0.0.0.0 for every interface)",
     )
     return parser
+
+
+def _measured_arguments(parser: argparse.ArgumentParser, design_help: str) -> None:
+    """MEASURED.csv --design DESIGN.json: what `fit` and `diagnose` both take."""
+    parser.add_argument("measured", metavar="MEASURED.csv", help="measured stiffness (FORMATS.md)")
+    parser.add_argument("--design", required=True, metavar="DESIGN.json", help=design_help)
 
 
 def _frequencies(args) -> np.ndarray:

@@ -356,7 +356,6 @@ class Step:
     gap_before: float
     gap_after: float
     candidates: dict[str, float]  # every candidate's BIC drop at this step
-    fitted: Fitted
     extra: dict = field(default_factory=dict)  # more evidence (the partner of a pair)
 
     def report(self) -> dict:
@@ -375,6 +374,7 @@ class Diagnosis:
     final: Fitted
     noise_variance: float | None
     unexplained: bool
+    where_baseline: str
     where_remaining: str
     held_out: dict = field(default_factory=dict)
 
@@ -396,7 +396,7 @@ class Diagnosis:
             "gap_baseline": self.baseline.gap,
             "gap_final": self.final.gap,
             "unexplained": self.unexplained,
-            "where_baseline": describe_fit(self.baseline, self),
+            "where_baseline": self.where_baseline,
             "where_remaining": self.where_remaining,
             "noise_gap": self.noise_gap,
             "points": len(self.data),
@@ -420,11 +420,6 @@ class Diagnosis:
             "final_magnitude": np.abs(kf),
             "final_loss_factor": kf.imag / kf.real,
         }
-
-
-def describe_fit(fitted: Fitted, diagnosis: Diagnosis) -> str:
-    sd = math.sqrt((diagnosis.noise_variance or fitted.mean_square) / 2.0)
-    return describe(diagnosis.data, fitted.stiffness, fitted.design.mode, sd)
 
 
 def _fit(model: Model, data: MeasuredStiffness, **kwargs) -> Fitted:
@@ -561,25 +556,14 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
     current = _fit(baseline_model(design, baseline), data, starts=BASELINE_STARTS)
     first = current
     noise = noise_variance(current.residual, data, runs)
-    steps: list[Step] = []
+    accepted: list[tuple] = []  # (effect, before, after, drops, fitted values from, evidence)
     done = 0.1  # progress: each round of candidates takes half of what is left up to 0.8
-
-    def step(eid: str, before: Fitted, after: Fitted, drops: dict, values_from: Fitted | None = None,
-             **evidence) -> Step:
-        effect = EFFECTS[eid]
-        values = parameter_values((values_from or after).design)
-        params = {p.name: values[p.name if effect.branch else f"{eid}.{p.name}"] for p in effect.parameters}
-        where = describe(data, before.stiffness, design.mode, math.sqrt((noise or before.mean_square) / 2.0))
-        explained = _explains(before, after, noise)[1]
-        return Step(eid, effect.title, where, before.bic - after.bic, explained, params, before.gap,
-                    after.gap, drops, after, evidence)
-
     while True:
         names = candidates(current.model)
         tried: dict[str, Fitted] = {}
         span = (0.8 - done) / 2
         for i, eid in enumerate(names):
-            say(done + span * i / len(names), f"step {len(steps) + 1}: trying {EFFECTS[eid].title.lower()}")
+            say(done + span * i / len(names), f"step {len(accepted) + 1}: trying {EFFECTS[eid].title.lower()}")
             fitted = _fit_candidate(current, eid, data)
             if fitted is not None:
                 tried[eid] = fitted
@@ -590,7 +574,7 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
             break
         best = max(drops, key=drops.get)
         if drops[best] > BIC_THRESHOLD and _explains(current, tried[best], noise)[0]:
-            steps.append(step(best, current, tried[best], drops))
+            accepted.append((best, current, tried[best], drops, tried[best], {}))
             current = tried[best]
             continue
         # no single effect explains the misfit: two that act together may (their fits interact
@@ -602,19 +586,35 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
         noise = _lower(noise, noise_variance(joint.residual, data, runs))
         if not _explains(current, joint, noise)[0]:
             break
-        steps.append(step(first_id, current, tried[first_id], drops, found_with=second_id, values_from=joint))
-        steps.append(step(second_id, tried[first_id], joint, {second_id: tried[first_id].bic - joint.bic},
-                          found_with=first_id))
+        accepted.append((first_id, current, tried[first_id], drops, joint, {"found_with": second_id}))
+        accepted.append((second_id, tried[first_id], joint, {second_id: tried[first_id].bic - joint.bic}, joint,
+                         {"found_with": first_id}))
         current = joint
     remaining = noise is not None and current.mean_square > NOISE_RATIO * noise
+
+    # the words, with the final noise estimate: each misfit described once
     sd = math.sqrt((noise or current.mean_square) / 2.0)
-    where = describe(data, current.stiffness, design.mode, sd) if remaining else "no misfit above the noise."
+    words: dict[int, str] = {}
+
+    def where(fitted: Fitted) -> str:
+        if id(fitted) not in words:
+            words[id(fitted)] = describe(data, fitted.stiffness, design.mode, sd)
+        return words[id(fitted)]
+
+    steps = []
+    for eid, before, after, step_drops, values_from, evidence in accepted:
+        effect = EFFECTS[eid]
+        values = parameter_values(values_from.design)
+        params = {p.name: values[p.name if effect.branch else f"{eid}.{p.name}"] for p in effect.parameters}
+        steps.append(Step(eid, effect.title, where(before), before.bic - after.bic, _explains(before, after, noise)[1],
+                          params, before.gap, after.gap, step_drops, evidence))
     held = {}
     if held_out:
         say(0.85, "checking on held-out data")
         held = _held_out(data, {"baseline": first, "final": current})
     say(1.0, "done")
-    return Diagnosis(data, first, steps, current, noise, remaining, where, held)
+    return Diagnosis(data, first, steps, current, noise, remaining, where(first),
+                     where(current) if remaining else "no misfit above the noise.", held)
 
 
 def summary(diagnosis: Diagnosis) -> str:
@@ -622,7 +622,7 @@ def summary(diagnosis: Diagnosis) -> str:
     lines = [f"baseline ({', '.join(diagnosis.baseline.model.branches)}): gap {diagnosis.baseline.gap:.4g}"]
     if diagnosis.noise_gap is not None:
         lines[0] += f" (noise alone gives about {diagnosis.noise_gap:.4g})"
-    lines.append(f"  where it disagrees: {describe_fit(diagnosis.baseline, diagnosis)}")
+    lines.append(f"  where it disagrees: {diagnosis.where_baseline}")
     for n, s in enumerate(diagnosis.steps, 1):
         params = ", ".join(f"{k} = {v:.4g}" for k, v in s.parameters.items()) or "no parameters"
         lines.append(f"step {n}: add {s.effect} ({s.title}): {params}; BIC drop {s.bic_drop:.1f}; "

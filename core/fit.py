@@ -66,14 +66,18 @@ def parameter_values(design: Design) -> dict[str, float]:
 
 
 def with_values(design: Design, values: dict[str, float]) -> Design:
-    """``design`` with parameters (fitting names, as :func:`parameter_values`) replaced."""
-    material = {k: v for k, v in values.items() if "." not in k}
-    effects = design.effect_parameters
-    for k, v in values.items():
-        if "." in k:
-            eid, _, p = k.rpartition(".")
-            effects.setdefault(eid, {})[p] = v
-    return design.replace(**material, effects=effects)
+    """``design`` with parameters (fitting names, as :func:`parameter_values`) replaced. The
+    effects are rebuilt (and validated) only when an effect parameter is among them: this runs
+    at every residual evaluation of a fit."""
+    changes: dict = {k: v for k, v in values.items() if "." not in k}
+    if len(changes) < len(values):
+        effects = design.effect_parameters
+        for k, v in values.items():
+            if "." in k:
+                eid, _, p = k.rpartition(".")
+                effects.setdefault(eid, {})[p] = v
+        changes["effects"] = effects
+    return design.replace(**changes)
 
 
 def gap(model: np.ndarray, data: np.ndarray) -> float:
