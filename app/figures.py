@@ -5,8 +5,8 @@ explorer's five plots through DynamicMaps took a median 0.6 s from a widget chan
 plot drawn (each update re-sent layout properties, and every one re-laid the page out). These
 figures are built once per session; an update replaces the data of their ColumnDataSources
 (batched in one message) and never touches layout, so the browser only redraws. Axes carry a
-name, label and unit once (:class:`Axis`); figures that share a quantity share a Bokeh range,
-so their axes are linked.
+name, label and unit once (:class:`Axis`); figures that share a quantity share a range
+(:class:`AutoRange`), so their axes are linked.
 """
 
 from __future__ import annotations
@@ -17,12 +17,15 @@ import numpy as np
 from bokeh import events
 from bokeh.core.properties import value
 from bokeh.models import (
+    CDSView,
     ColorBar,
     ColumnDataSource,
-    DataRange1d,
+    CustomJS,
     HoverTool,
+    IndexFilter,
     Legend,
     LegendItem,
+    Range1d,
     SaveTool,
     Span,
 )
@@ -42,6 +45,105 @@ class Axis:
         return f"{self.label} ({self.unit})" if self.unit else self.label
 
 
+X_COLUMNS = ("x", "xs")
+Y_COLUMNS = ("y", "ys", "y1", "y2")
+RAGGED = ("xs", "ys")  # a list of arrays (multi_line)
+
+
+def padded(low: float, high: float, log: bool) -> tuple[float, float]:
+    """The range Bokeh's DataRange1d would give data from ``low`` to ``high``: 10 % more than the
+    span (in log10 on a log axis), or a span of 2 (two decades) around a single value."""
+    if log:
+        low, high = np.log10(low), np.log10(high)
+    centre = (low + high) / 2
+    half = (high - low) * (1 + AutoRange.PADDING) / 2 if high > low else AutoRange.DEFAULT_SPAN / 2
+    start, end = centre - half, centre + half
+    return (float(10**start), float(10**end)) if log else (float(start), float(end))
+
+
+class AutoRange:
+    """A Bokeh Range1d that the server fits to the data of every figure sharing it, padded as a
+    DataRange1d would be.
+
+    Why not a DataRange1d: BokehJS fits those while it paints, and a range that changes then
+    asks every plot on it to paint again and sends itself back to the server. Measured in
+    Chromium, every plot of the explorer painted twice per material change. Fitted here, the
+    ranges travel in the same message as the data and each plot paints once. A zoom or pan by the
+    user is kept (later data do not move the view) until the plot's reset tool, which returns to
+    the newest fit, or until the axis changes its quantity."""
+
+    PADDING = 0.1
+    DEFAULT_SPAN = 2.0
+
+    def __init__(self, start: float | None = None, end: float | None = None):
+        self.fixed = start is not None and end is not None
+        self.range = Range1d(start=0.0 if start is None else start, end=1.0 if end is None else end)
+        self.log: bool | None = None
+        self.zoomed = False
+        self._members: list[tuple[Figure, str]] = []
+        self._fit = (self.range.start, self.range.end)
+        self._setting = False
+        self.range.on_change("start", self._moved)
+        self.range.on_change("end", self._moved)
+
+    def attach(self, fig: Figure, dim: str, log: bool):
+        if self.log is not None and self.log != log:
+            raise ValueError("figures that share a range must share its scale (linear or log)")
+        self.log = log
+        self._members.append((fig, dim))
+
+    def _moved(self, _attr, _old, _new):
+        """A change from the browser (zoom, pan or reset): zoomed unless back on the fit."""
+        if not self._setting:
+            self.zoomed = (self.range.start, self.range.end) != self._fit
+
+    def fit(self):
+        """Refit to the members' data (nothing to do for a fixed range or no data)."""
+        if self.fixed:
+            return
+        extents = [e for fig, dim in self._members if (e := fig.extent(dim)) is not None]
+        if not extents:
+            return
+        fit = padded(min(e[0] for e in extents), max(e[1] for e in extents), bool(self.log))
+        if fit == self._fit and (self.zoomed or (self.range.start, self.range.end) == fit):
+            return
+        self._fit = fit
+        changes = {"reset_start": fit[0], "reset_end": fit[1]}
+        if not self.zoomed:
+            changes.update(start=fit[0], end=fit[1])
+        self._setting = True
+        try:
+            self.range.update(**changes)
+        finally:
+            self._setting = False
+
+    def unzoom(self):
+        self.zoomed = False
+        self._fit = (None, None)
+        self.fit()
+
+
+def _range(spec) -> AutoRange:
+    """An :class:`AutoRange` from None (a new one), a (start, end) pair (fixed) or itself."""
+    if spec is None:
+        return AutoRange()
+    if isinstance(spec, AutoRange):
+        return spec
+    start, end = spec
+    return AutoRange(start, end)
+
+
+# After a legend click (the event comes before the legend toggles the proxy, hence the
+# microtask): each glyph takes its proxy's visibility; a multi_line shows the lines whose
+# proxies are visible.
+FOLLOW_PROXIES = """
+queueMicrotask(() => {
+  proxies.forEach((proxy, i) => { if (targets[i].visible != proxy.visible) targets[i].visible = proxy.visible })
+  filters.forEach((filter, i) => { filter.indices = line_proxies[i].flatMap((p, k) => p.visible ? [k] : []) })
+})
+"""
+
+
 class Figure:
     """A titled Bokeh figure of named lines and bands, an optional operating-point marker and
     a legend; :meth:`set` replaces one glyph's data."""
@@ -54,8 +156,8 @@ class Figure:
         *,
         x_log: bool = False,
         y_log: bool = False,
-        x_range=None,
-        y_range=None,
+        x_range: AutoRange | tuple[float, float] | None = None,
+        y_range: AutoRange | tuple[float, float] | None = None,
         height: int = 300,
         png: str = "bushing-plot",
         legend: str | None = "right",
@@ -63,12 +165,14 @@ class Figure:
         hover: bool = True,
     ):
         self.x, self.y = x, y
+        self.ranges = {"x": _range(x_range), "y": _range(y_range)}
+        self.log = {"x": x_log, "y": y_log}
         self.fig = figure(
             title=title,
             x_axis_type="log" if x_log else "linear",
             y_axis_type="log" if y_log else "linear",
-            x_range=x_range if x_range is not None else DataRange1d(),
-            y_range=y_range if y_range is not None else DataRange1d(),
+            x_range=self.ranges["x"].range,
+            y_range=self.ranges["y"].range,
             height=height,
             sizing_mode="stretch_width",
             tools="pan,wheel_zoom,box_zoom,reset",
@@ -80,15 +184,22 @@ class Figure:
         self.fig.toolbar.logo = None
         self.fig.xaxis.axis_label = x.title
         self.fig.yaxis.axis_label = y.title
+        for dim, rng in self.ranges.items():
+            rng.attach(self, dim, self.log[dim])
         self.sources: dict[str, ColumnDataSource] = {}
         self.renderers = {}
+        self._extents: dict[str, dict[str, tuple[float, float] | None]] = {}
         self._line_colors: dict[str, list[str]] = {}
+        self._items: dict[str, list[LegendItem]] = {}
         self.legend = None
         if legend:
             self.legend = Legend(items=[], location="top_left" if legend == "inside" else "center",
                                  click_policy="hide", label_text_font_size="11px",
                                  spacing=0, padding=4, margin=4)
             self.fig.add_layout(self.legend, "right" if legend == "right" else "center")
+            self._follow = {"proxies": [], "targets": [], "filters": [], "line_proxies": []}
+            self._click = CustomJS(args=dict(self._follow), code=FOLLOW_PROXIES)
+            self.legend.js_on_event("legend_item_click", self._click)
         self.marker = None
         if marker:
             self.marker = Span(location=0.0, dimension="height", line_color="#e6550d",
@@ -107,8 +218,26 @@ class Figure:
         self.sources[key] = src
         self.renderers[key] = draw(src)
         if label is not None and self.legend is not None:
-            self.legend.items.append(LegendItem(label=value(label), renderers=[self.renderers[key]]))
+            proxy = draw(ColumnDataSource({c: [np.nan] for c in columns}))
+            self._follow["proxies"].append(proxy)
+            self._follow["targets"].append(self.renderers[key])
+            self._add_item(key, label, proxy)
         return self.renderers[key]
+
+    def _add_item(self, key: str, label: str, proxy):
+        """A legend entry drawn by ``proxy``, a renderer styled like the real one whose one
+        point is NaN: nothing in the plot, but a swatch in the legend (BokehJS draws none for
+        a renderer without data).
+
+        Why a proxy: BokehJS rebuilds a legend's entries whenever anything reachable from them
+        changes, the data of their renderers included; measured in Chromium, that made the
+        legends the largest cost of an update. A proxy's data never change, so the legend is
+        built once; clicking an entry hides the proxy, and the legend's click callback (which
+        the legend does not watch) makes the real glyphs follow their proxies."""
+        item = LegendItem(label=value(label), renderers=[proxy])
+        self.legend.items.append(item)
+        self._items.setdefault(key, []).append(item)
+        self._click.args = dict(self._follow)
 
     def line(self, key: str, label: str | None = None, **style):
         return self._glyph(key, ("x", "y"), lambda src: self.fig.line("x", "y", source=src, **style), label)
@@ -136,33 +265,63 @@ class Figure:
                            lambda src: self.fig.varea("x", "y1", "y2", source=src, **style), label)
 
     def lines(self, key: str, labels: list[str], colors: list[str], **style):
-        """Several lines in one glyph and one source (one patch per update), each in the legend."""
+        """Several lines in one glyph and one source (one patch per update), each in the legend;
+        clicking an entry hides that line alone (an index filter on the glyph's view)."""
         renderer = self._glyph(key, ("xs", "ys", "color"), lambda src: self.fig.multi_line(
             "xs", "ys", source=src, line_color="color", **style), None)
         self._line_colors[key] = list(colors)
-        if self.legend is not None:
-            for i, label in enumerate(labels):
-                self.legend.items.append(LegendItem(label=value(label), renderers=[renderer], index=i))
+        if self.legend is not None and labels:
+            shown = IndexFilter(indices=list(range(len(labels))))
+            renderer.view = CDSView(filter=shown)
+            proxies = [self.fig.line(x=[np.nan], y=[np.nan], line_color=colors[i % len(colors)], **style)
+                       for i in range(len(labels))]
+            self._follow["filters"].append(shown)
+            self._follow["line_proxies"].append(proxies)
+            for label, proxy in zip(labels, proxies):
+                self._add_item(key, label, proxy)
         return renderer
 
     def set_lines(self, key: str, x, ys, labels: list[str]):
         """Replace the lines of :meth:`lines` (all on the same x) and relabel them if needed."""
         colors = self._line_colors[key]
         x = np.asarray(x, dtype=float)
-        self.sources[key].data = {
+        data = {
             "xs": [x] * len(ys),
             "ys": [np.asarray(y, dtype=float) for y in ys],
             "color": [colors[i % len(colors)] for i in range(len(ys))],
         }
-        items = [it for it in self.legend.items if self.renderers[key] in it.renderers]
+        self.sources[key].data = data
+        self._record(key, data)
+        items = self._items.get(key, [])
         for item, label in zip(items, labels):
             if getattr(item.label, "value", item.label) != label:
                 item.label = value(label)
 
     def set(self, key: str, **columns):
         """Replace one glyph's data (numbers; a ``color`` column stays text)."""
-        self.sources[key].data = {k: list(v) if k == "color" else np.asarray(v, dtype=float)
-                                  for k, v in columns.items()}
+        data = {k: list(v) if k == "color" else np.asarray(v, dtype=float) for k, v in columns.items()}
+        self.sources[key].data = data
+        self._record(key, data)
+
+    def _record(self, key: str, data: dict):
+        """Keep the extent of one glyph's data and refit this figure's ranges to it."""
+        self._extents[key] = {}
+        for dim, names in (("x", X_COLUMNS), ("y", Y_COLUMNS)):
+            parts = [np.ravel(np.asarray(v, dtype=float)) for n in names if n in data
+                     for v in (data[n] if n in RAGGED else [data[n]])]
+            values = np.concatenate(parts) if parts else np.empty(0)
+            values = values[np.isfinite(values) & ((values > 0) if self.log[dim] else True)]
+            self._extents[key][dim] = (float(values.min()), float(values.max())) if values.size else None
+        for rng in self.ranges.values():
+            rng.fit()
+
+    def extent(self, dim: str) -> tuple[float, float] | None:
+        """The smallest and largest finite value (positive, on a log axis) of all this figure's
+        data along ``dim`` ("x" or "y"), or None without data."""
+        found = [e[dim] for e in self._extents.values() if e.get(dim) is not None]
+        if not found:
+            return None
+        return min(lo for lo, _ in found), max(hi for _, hi in found)
 
     def clear(self, key: str):
         self.set(key, **{k: [] for k in self.sources[key].data})
@@ -171,8 +330,10 @@ class Figure:
         """Change the axis titles (the mode changes units); sent only when they change."""
         if self.fig.xaxis[0].axis_label != x.title:
             self.fig.xaxis.axis_label = x.title
+            self.ranges["x"].unzoom()
         if self.fig.yaxis[0].axis_label != y.title:
             self.fig.yaxis.axis_label = y.title
+            self.ranges["y"].unzoom()
         self.x, self.y = x, y
 
     def set_marker(self, value: float):

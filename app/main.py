@@ -7,6 +7,8 @@ import os
 import sys
 
 import panel as pn
+import param
+from bokeh.models import CustomJS
 
 from .diagnosis import DiagnosisView
 from .diagnosis_state import DiagnosisState
@@ -44,6 +46,42 @@ axially and N·m/rad in torsion. Files and the command line use SI.
 """
 
 
+URL_DELAY_MS = 300
+
+# BokehJS rewrites the text of a plot component's stylesheet on every paint, nearly always with
+# the text it already has; each rewrite makes Chromium recollect the page's styles. Measured in
+# Chromium on this machine, that was a fifth of the page's work per update. Skipping a rewrite
+# that changes nothing changes nothing on screen. (Bokeh 3.9; the method is looked up, and
+# nothing is patched if it is not there.)
+SKIP_UNCHANGED_STYLE_WRITES = """
+if (window.bushingStyleWrites == null) {
+  const dom = Bokeh.require("core/dom")
+  const sheet = dom != null && dom.InlineStyleSheet != null ? dom.InlineStyleSheet.prototype : null
+  if (sheet != null && typeof sheet._update === "function") {
+    const update = sheet._update
+    sheet._update = function (css) { if (this.el.textContent !== css) update.call(this, css) }
+    window.bushingStyleWrites = "skip-unchanged"
+  } else {
+    window.bushingStyleWrites = "unpatched"
+  }
+}
+"""
+
+
+class ShareLink(param.Parameterized):
+    """The design as the address bar shows it: the state's linked parameters, untouched by
+    validation (the state judges them). A link opened (or the browser's back button) applies
+    at once; the state's changes reach the address bar after a pause, so a slider drag is one
+    history entry and one URL write, not one per step."""
+
+    mode = param.Selector(objects=["axial", "torsion"], default="axial")
+
+
+for _name in URL_NAMES:
+    if _name != "mode":
+        ShareLink.param.add_parameter(_name, param.Number(default=None, allow_None=True))
+
+
 class App(pn.viewable.Viewer):
     """One session of the explorer: its own state, inputs, plots and URL."""
 
@@ -76,10 +114,45 @@ class App(pn.viewable.Viewer):
         for index, view in self._tab_views.items():
             view.show(index == self.tabs.active)
 
-    def sync_url(self):
+    def sync_url(self, delay_ms: int = URL_DELAY_MS):
         """Put the whole design in the URL, and read one from it (a shared link)."""
-        if pn.state.location is not None:
-            pn.state.location.sync(self.state, URL_NAMES, on_error=self.state.apply_url_values)
+        location = pn.state.location
+        if location is None:
+            return
+        self.link = ShareLink(**{name: getattr(self.state, name) for name in URL_NAMES})
+        self._copying = False
+        self._pending = None
+        self.link.param.watch(self._from_link, list(URL_NAMES))
+        location.sync(self.link, URL_NAMES, on_error=self.state.apply_url_values)
+        self.state.param.watch(lambda *_events: self._schedule_link(delay_ms), list(URL_NAMES))
+
+    def _from_link(self, *events):
+        if self._copying:
+            return
+        values = {e.name: e.new for e in events}
+        try:
+            self.state.param.update(values)
+        except Exception:  # noqa: BLE001 - one bad value: apply the others, say which
+            self.state.apply_url_values(values)
+
+    def _schedule_link(self, delay_ms: int):
+        doc = pn.state.curdoc
+        if doc is None:
+            return self._to_link()
+        if self._pending is not None:
+            try:
+                doc.remove_timeout_callback(self._pending)
+            except ValueError:
+                pass  # it has just run
+        self._pending = doc.add_timeout_callback(self._to_link, delay_ms)
+
+    def _to_link(self):
+        self._pending = None
+        self._copying = True
+        try:
+            self.link.param.update({name: getattr(self.state, name) for name in URL_NAMES})
+        finally:
+            self._copying = False
 
     def template(self):
         template = pn.template.BootstrapTemplate(
@@ -100,6 +173,8 @@ def create_app():
     """Factory for one session (served per connection, so sessions never share state)."""
     app = App()
     app.sync_url()
+    if pn.state.curdoc is not None:
+        pn.state.curdoc.js_on_event("document_ready", CustomJS(code=SKIP_UNCHANGED_STYLE_WRITES))
     return app.template()
 
 

@@ -10,14 +10,13 @@ import logging
 
 import numpy as np
 import panel as pn
-from bokeh.models import DataRange1d
 
 from core import PAPER_B
 from core.fit import PARAMETERS
 from core.synthetic import loop_csv, paper_b_example
 
 from . import plots
-from .figures import Axis, Figure
+from .figures import AutoRange, Axis, Figure
 from .state import ExplorerState
 from .views import PlotView
 
@@ -69,7 +68,7 @@ class MeasuredView(PlotView):
         self.summary = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.results = pn.pane.Markdown("", sizing_mode="stretch_width")
         axes = {"frequency": Axis("frequency_hz", "Frequency", "Hz"), "amplitude": Axis("amplitude", "Amplitude", "")}
-        shared_y = {"magnitude": DataRange1d(), "loss": DataRange1d()}
+        shared_y = {"magnitude": AutoRange(), "loss": AutoRange()}
         for which, x in axes.items():
             for quantity, y in (("magnitude", Axis("residual", "|K| residual", "%")),
                                 ("loss", Axis("residual", "Loss-factor residual", ""))):

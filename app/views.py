@@ -13,13 +13,13 @@ import typing
 
 import numpy as np
 import panel as pn
-from bokeh.models import CustomJSTickFormatter, DataRange1d
+from bokeh.models import CustomJSTickFormatter
 
 from core.bushing import STRUCTURAL_EFFECTS
 from core.design import dumps_design
 
 from . import plots
-from .figures import Axis, Figure
+from .figures import AutoRange, Axis, Figure
 from .state import AMPLITUDE_DISPLAY, DESIGN_FIELDS, FORCE_DISPLAY, STIFFNESS_DISPLAY, ExplorerState
 
 log = logging.getLogger("bushing.app")
@@ -78,8 +78,10 @@ class LogSlider(pn.viewable.Viewer):
             setattr(self._state, self._name, value)
 
     def _from_state(self, event):
+        """Move the slider to a value set elsewhere (a tap, a link, a preset); not back to the
+        4-digit rounding of its own value, which would send every move back to the browser."""
         v = self._clip(math.log10(event.new))
-        if abs(v - self.slider.value) > 1e-9:
+        if abs(v - self.slider.value) > self.slider.step / 2:
             self.slider.value = v
 
     def _rescale(self, _event):
@@ -238,7 +240,7 @@ class ExplorerPlots(PlotView):
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
         axes = _axes(state.design.mode)
-        shared = {name: DataRange1d() for name in ("frequency", "amplitude", "magnitude", "loss_factor")}
+        shared = {name: AutoRange() for name in ("frequency", "amplitude", "magnitude", "loss_factor")}
         self.loop = Figure("Hysteresis loop at the operating point", axes["displacement"], axes["force"],
                            height=330, png="bushing-hysteresis-loop", legend="inside")
         for name, color in plots.BRANCH_COLORS.items():
@@ -344,7 +346,7 @@ class SlicesView(PlotView):
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
         axes = _axes(state.design.mode)
-        shared_x = DataRange1d()
+        shared_x = AutoRange()
         specs = {
             "magnitude": ("|K|: single modulus, slices and continuum", axes["magnitude"], (1, 2, 3, "continuum")),
             "magnitude_diff_pct": ("|K| difference from the single modulus (%)", axes["difference"], (2, 3, "continuum")),
@@ -413,7 +415,7 @@ class TeachingView(PlotView):
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
         axes = _axes(state.design.mode)
-        shared_x = DataRange1d()
+        shared_x = AutoRange()
         self.player = pn.widgets.Player(
             label="Amplitude sweep", start=0, end=self.FRAMES - 1, value=self.FRAMES // 2,
             loop_policy="loop", interval=150, show_value=False, show_loop_controls=False,
@@ -429,8 +431,8 @@ class TeachingView(PlotView):
             self.figures[which] = fig
         rel = (Axis("x_rel", "Drive / peak drive"), Axis("f_rel", "Force / peak force"))
         self.loop = Figure("Loop shape during the amplitude sweep", *rel, height=420,
-                           png="bushing-loop-shape", legend="inside", x_range=DataRange1d(start=-1.05, end=1.05),
-                           y_range=DataRange1d(start=-1.1, end=1.1))
+                           png="bushing-loop-shape", legend="inside", x_range=(-1.05, 1.05),
+                           y_range=(-1.1, 1.1))
         self.loop.line("total", "total", color="black", line_width=2.5)
         for name, color in plots.BRANCH_COLORS.items():
             self.loop.line(name, name, color=color, line_width=1.5)

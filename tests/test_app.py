@@ -316,3 +316,90 @@ def test_the_thesis_two_step_fit_in_the_app(app):
     assert r.method == "two-step" and r.points == 30  # the 0.1 mm sweep
     assert r.design.material.shear_modulus == pytest.approx(2.42e6, rel=0.03)
     assert "two-step" in app.measured.results.object
+
+
+# ---- plot ranges, fitted on the server ------------------------------------------------------
+
+
+def _values(fig, dim):
+    """Every finite value a figure holds along x or y, read from its sources."""
+    names = ("x", "xs") if dim == "x" else ("y", "ys", "y1", "y2")
+    out = []
+    for src in fig.sources.values():
+        for name in names:
+            for v in src.data.get(name, []) if name.endswith("s") else [src.data.get(name, [])]:
+                out.append(np.ravel(np.asarray(v, dtype=float)))
+    v = np.concatenate(out)
+    return v[np.isfinite(v)]
+
+
+def _expected(values, log):
+    """Bokeh's DataRange1d padding, written out: the span grows by 10 %, 5 % each side (in
+    log10 on a log axis)."""
+    v = np.log10(values[values > 0]) if log else values
+    lo, hi = v.min(), v.max()
+    start, end = lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo)
+    return (10**start, 10**end) if log else (start, end)
+
+
+def test_shared_ranges_cover_the_data_of_every_figure_on_them(app):
+    app.state.shear_modulus_mpa = 3.3
+    k_f, k_a = figure(app, "magnitude", "frequency"), figure(app, "magnitude", "amplitude")
+    eta_f = figure(app, "loss_factor", "frequency")
+    assert k_f.fig.y_range is k_a.fig.y_range and k_f.fig.x_range is eta_f.fig.x_range
+    both = np.concatenate([_values(k_f, "y"), _values(k_a, "y")])
+    assert (k_f.fig.y_range.start, k_f.fig.y_range.end) == pytest.approx(_expected(both, False), rel=1e-12)
+    amplitudes = _values(k_a, "x")
+    assert (k_a.fig.x_range.start, k_a.fig.x_range.end) == pytest.approx(_expected(amplitudes, True), rel=1e-12)
+    assert amplitudes.min() == pytest.approx(app.state.amplitude_bounds[0])
+    loop_fig = app.plots.loop
+    assert (loop_fig.fig.y_range.start, loop_fig.fig.y_range.end) == pytest.approx(
+        _expected(_values(loop_fig, "y"), False), rel=1e-12)
+
+
+def test_a_zoom_is_kept_until_reset(app):
+    fig = figure(app, "magnitude", "frequency")
+    rng = fig.fig.y_range
+    rng.update(start=4.0, end=4.2)  # as a wheel zoom in the browser arrives
+    app.state.shear_modulus_mpa = 3.0
+    assert (rng.start, rng.end) == (4.0, 4.2)
+    fitted = _expected(np.concatenate([_values(fig, "y"), _values(figure(app, "magnitude", "amplitude"), "y")]), False)
+    assert (rng.reset_start, rng.reset_end) == pytest.approx(fitted, rel=1e-12)  # where reset goes
+    rng.update(start=rng.reset_start, end=rng.reset_end)  # the reset tool
+    app.state.shear_modulus_mpa = 2.0
+    assert rng.start < 4.0 and (rng.start, rng.end) == (rng.reset_start, rng.reset_end)
+
+
+def test_a_mode_change_drops_a_zoom(app):
+    rng = figure(app, "magnitude", "frequency").fig.y_range
+    rng.update(start=4.0, end=4.2)
+    app.state.preset = "Table 1 bushing (torsion)"
+    assert rng.end > 4.2 and rng.start == rng.reset_start
+
+
+def test_legend_entries_are_proxies_styled_like_their_glyphs(app):
+    """Legends name empty proxy renderers (BokehJS rebuilds a legend when its renderers' data
+    change); a click on a legend makes the real glyphs follow their proxies."""
+    fig = figure(app, "magnitude", "frequency")
+    items = fig.legend.items
+    assert [it.label.value for it in items][-3:] == ["reference", "operating point", "measured"]
+    follow = fig._click.args
+    assert follow["targets"] == [fig.renderers[k] for k in ("reference", "operating", "measured")]
+    for proxy, target in zip(follow["proxies"], follow["targets"]):
+        assert np.isnan(proxy.data_source.data["x"]).all()  # one NaN point: a swatch, no line
+        assert type(proxy.glyph) is type(target.glyph)
+        assert proxy.glyph.properties_with_values() == target.glyph.properties_with_values()
+    assert len(fig.sources["operating"].data["x"]) > 0
+    (sweep_proxies,) = follow["line_proxies"]
+    assert [p.glyph.line_color for p in sweep_proxies] == fig.sources["sweeps"].data["color"]
+    assert follow["filters"][0].indices == list(range(len(sweep_proxies)))
+
+
+def test_the_slider_keeps_its_own_position(app):
+    """A slider move sets the amplitude to 4 digits; the slider is not sent back to it."""
+    slider = app.inputs.amplitude.slider
+    slider.value = -1.2345678
+    assert app.state.amplitude == float(f"{10**-1.2345678:.4g}")
+    assert slider.value == -1.2345678
+    app.state.amplitude = 0.5  # set elsewhere (a tap): the slider follows
+    assert slider.value == pytest.approx(np.log10(0.5))

@@ -288,3 +288,55 @@ def test_mystery_demo_reveals_its_truth(page, explorer_url):
     page.get_by_role("button", name="Reveal the truth").click()
     page.get_by_text(re.compile("Hidden in the data|Nothing was hidden")).wait_for(timeout=10000)
     assert page.get_by_text("The diagnosis found exactly that.").count() == 1
+
+
+SHOWN_JS = """(title) => {
+  const fig = [...Bokeh.documents[0].all_models].find(m => m.type === 'Figure' && m.title && m.title.text === title);
+  const real = fig.renderers.filter(r => r.data_source.get_length() > 1);  // legend proxies hold one NaN
+  const sweeps = real.find(r => r.glyph.type === 'MultiLine');
+  return {
+    sweeps: sweeps.view.filter.indices,
+    lines: real.filter(r => r.glyph.type === 'Line').map(r => [r.glyph.line_width.value, r.visible]),
+  };
+}"""
+
+
+def test_legend_entries_hide_their_lines(page, explorer_url):
+    open_explorer(page, explorer_url)
+    assert page.evaluate("() => window.bushingStyleWrites") == "skip-unchanged"
+    title = "|K| against frequency"
+    labels = plots(page)[title]["legends"]
+    assert page.evaluate(SHOWN_JS, title) == {"sweeps": [0, 1, 2, 3], "lines": [[3, True]]}
+    # the first figure with these entries in the page is the top-left one, |K| against frequency
+    page.locator(".bk-item", has_text=labels[1]).first.click()
+    page.locator(".bk-item", has_text="operating point").first.click()
+    page.wait_for_function(f"() => ({SHOWN_JS})({title!r}).sweeps.length === 3")
+    assert page.evaluate(SHOWN_JS, title) == {"sweeps": [0, 2, 3], "lines": [[3, False]]}
+    assert page.evaluate(SHOWN_JS, "Loss factor against frequency")["sweeps"] == [0, 1, 2, 3]
+    # hidden lines stay hidden through an update, and come back on a second click
+    page.get_by_label("Shear modulus µ (MPa)").fill("3")
+    page.get_by_label("Shear modulus µ (MPa)").press("Enter")
+    wait_quiet(page)
+    assert page.evaluate(SHOWN_JS, title) == {"sweeps": [0, 2, 3], "lines": [[3, False]]}
+    page.locator(".bk-item", has_text=labels[1]).first.click()
+    page.locator(".bk-item", has_text="operating point").first.click()
+    page.wait_for_function(f"() => ({SHOWN_JS})({title!r}).sweeps.length === 4")
+    assert page.evaluate(SHOWN_JS, title) == {"sweeps": [0, 1, 2, 3], "lines": [[3, True]]}
+
+
+def test_a_slider_drag_is_one_history_entry(page, explorer_url):
+    """The address bar follows the design after a pause: quick moves make one entry, and the
+    link holds the last value."""
+    open_explorer(page, explorer_url)
+    before = page.evaluate("() => history.length")
+    field = page.get_by_label("Shear modulus µ (MPa)")
+    for value in ("2.5", "2.6", "2.7", "2.8"):
+        field.fill(value)
+        field.press("Enter")
+    page.wait_for_url(re.compile(r"mu_MPa=2\.8"))
+    wait_quiet(page)
+    assert page.evaluate("() => history.length") - before <= 2
+    page.goto(page.url)
+    page.locator(".bk-Canvas").nth(4).wait_for(timeout=30000)
+    wait_quiet(page)
+    assert page.get_by_label("Shear modulus µ (MPa)").input_value() == "2.8"
