@@ -13,7 +13,9 @@ Starts `bushing serve` on a free port, opens the explorer in the system Chromium
   (each as soon as its last change is drawn), which saturates the machine.
 
 All N pages run in one Chromium on this same 2-core machine as the server, so the pages'
-rendering competes with the server for the CPU; users on their own machines would not.
+rendering competes with the server for the CPU; users on their own machines would not. For the
+simultaneous rounds the script also prints the CPU time per change of the server and of
+Chromium's processes (page renderers, GPU/compositor, browser), read from /proc.
 
 Targets: median ≤ 150 ms and p95 ≤ 300 ms with one session; p95 ≤ 500 ms with 10 sessions;
 first load ≤ 3 s.
@@ -23,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import os
 import shutil
 import socket
 import statistics
@@ -70,6 +73,32 @@ CHANGE_JS = """async ([title, value, quiet]) => {
   doc.remove_on_change(cb);
   return ok ? lastPaint - t0 : null;
 }"""
+
+
+def cpu_seconds(pid) -> float:
+    """User + system CPU time of one process (Linux /proc), 0 if it is gone."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def chromium_cpu() -> dict[str, float]:
+    """CPU seconds of every Chromium process, by process type (renderer, gpu-process, …)."""
+    out: dict[str, float] = {}
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as f:
+                cmd = f.read().replace(b"\0", b" ").decode(errors="replace")
+        except OSError:
+            continue
+        if "chrom" not in cmd.split(" ")[0]:
+            continue
+        kind = next((a[7:] for a in cmd.split(" ") if a.startswith("--type=")), "browser")
+        out[kind] = out.get(kind, 0.0) + cpu_seconds(pid)
+    return out
 
 
 def free_port():
@@ -162,10 +191,16 @@ async def main(n_changes, n_sessions):
                 await run_changes(pg, 2)
             # rounds: every session changes a widget at the same moment, then a person's pause
             rounds = []
+            server0, chromium0 = cpu_seconds(server.pid), chromium_cpu()
             for _ in range(max(10, n_changes // 2)):
                 rounds += await asyncio.gather(*(run_changes(pg, 1) for pg in pages))
                 await asyncio.sleep(0.5)
+            server1, chromium1 = cpu_seconds(server.pid), chromium_cpu()
             report(f"{n_sessions} sessions, simultaneous rounds", [v for r in rounds for v in r], "target p95 ≤ 500 ms")
+            n = sum(len(r) for r in rounds)
+            kinds = ", ".join(f"{k} {1000 * (chromium1[k] - chromium0.get(k, 0.0)) / n:.0f}"
+                              for k in sorted(chromium1) if chromium1[k] - chromium0.get(k, 0.0) > 0)
+            print(f"{'  CPU per change (ms)':<34} server {1000 * (server1 - server0) / n:.0f}; Chromium: {kinds}")
             # back to back: each session changes again as soon as its plots are drawn (saturation)
             results = await asyncio.gather(*(run_changes(pg, max(10, n_changes // 2)) for pg in pages))
             report(f"{n_sessions} sessions, back to back", [v for r in results for v in r], "saturation, for reference")
