@@ -166,7 +166,6 @@ class Figure:
     ):
         self.x, self.y = x, y
         self.ranges = {"x": _range(x_range), "y": _range(y_range)}
-        self.log = {"x": x_log, "y": y_log}
         self.fig = figure(
             title=title,
             x_axis_type="log" if x_log else "linear",
@@ -185,7 +184,7 @@ class Figure:
         self.fig.xaxis.axis_label = x.title
         self.fig.yaxis.axis_label = y.title
         for dim, rng in self.ranges.items():
-            rng.attach(self, dim, self.log[dim])
+            rng.attach(self, dim, {"x": x_log, "y": y_log}[dim])
         self.sources: dict[str, ColumnDataSource] = {}
         self.renderers = {}
         self._extents: dict[str, dict[str, tuple[float, float] | None]] = {}
@@ -310,7 +309,7 @@ class Figure:
             parts = [np.ravel(np.asarray(v, dtype=float)) for n in names if n in data
                      for v in (data[n] if n in RAGGED else [data[n]])]
             values = np.concatenate(parts) if parts else np.empty(0)
-            values = values[np.isfinite(values) & ((values > 0) if self.log[dim] else True)]
+            values = values[np.isfinite(values) & ((values > 0) if self.ranges[dim].log else True)]
             self._extents[key][dim] = (float(values.min()), float(values.max())) if values.size else None
         for rng in self.ranges.values():
             rng.fit()
