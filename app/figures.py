@@ -144,6 +144,27 @@ queueMicrotask(() => {
 """
 
 
+def _same_data(old: dict, new: dict) -> bool:
+    """Whether two sources' data are the same columns of the same values (NaN equal to NaN)."""
+    if old.keys() != new.keys():
+        return False
+    for name, b in new.items():
+        a = old[name]
+        if name in RAGGED:
+            if len(a) != len(b) or not all(_same_column(x, y) for x, y in zip(a, b)):
+                return False
+        elif not _same_column(a, b):
+            return False
+    return True
+
+
+def _same_column(a, b) -> bool:
+    a, b = np.asarray(a), np.asarray(b)
+    if a.shape != b.shape or a.dtype.kind != b.dtype.kind:
+        return False
+    return bool(np.array_equal(a, b, equal_nan=a.dtype.kind == "f"))
+
+
 class Figure:
     """A titled Bokeh figure of named lines and bands, an optional operating-point marker and
     a legend; :meth:`set` replaces one glyph's data."""
@@ -201,8 +222,9 @@ class Figure:
             self.legend.js_on_event("legend_item_click", self._click)
         self.marker = None
         if marker:
+            # On the overlay layer: moving it repaints that layer alone, not the plot under it.
             self.marker = Span(location=0.0, dimension="height", line_color="#e6550d",
-                               line_dash="dotted", line_width=1.5)
+                               line_dash="dotted", line_width=1.5, level="overlay")
             self.fig.add_layout(self.marker)
         if hover:
             self.fig.add_tools(HoverTool(
@@ -289,8 +311,7 @@ class Figure:
             "ys": [np.asarray(y, dtype=float) for y in ys],
             "color": [colors[i % len(colors)] for i in range(len(ys))],
         }
-        self.sources[key].data = data
-        self._record(key, data)
+        self._send(key, data)
         items = self._items.get(key, [])
         for item, label in zip(items, labels):
             if getattr(item.label, "value", item.label) != label:
@@ -299,6 +320,13 @@ class Figure:
     def set(self, key: str, **columns):
         """Replace one glyph's data (numbers; a ``color`` column stays text)."""
         data = {k: list(v) if k == "color" else np.asarray(v, dtype=float) for k, v in columns.items()}
+        self._send(key, data)
+
+    def _send(self, key: str, data: dict):
+        """Give one glyph new data, unless they equal what it has: the browser repaints a plot
+        whenever a source of it changes, even to the same numbers."""
+        if _same_data(self.sources[key].data, data):
+            return
         self.sources[key].data = data
         self._record(key, data)
 

@@ -25,6 +25,10 @@ from .views import (
     status_banner,
 )
 
+# Every component is styled by the template's design from the start. With Panel's default
+# design, each update of a pane re-sent the pane's stylesheets (the default theme's, then the
+# template's), and Bokeh re-collected every model of the document each time: measured with
+# several sessions, ~9 ms of the server per change.
 pn.extension(throttled=False)
 
 TITLE = "Bushing Explorer"
@@ -48,12 +52,22 @@ axially and N·m/rad in torsion. Files and the command line use SI.
 
 URL_DELAY_MS = 300
 
-# BokehJS rewrites the text of a plot component's stylesheet on every paint, nearly always with
-# the text it already has; each rewrite makes Chromium recollect the page's styles. Measured in
-# Chromium on this machine, that was a fifth of the page's work per update. Skipping a rewrite
-# that changes nothing changes nothing on screen. (Bokeh 3.9; the method is looked up, and
-# nothing is patched if it is not there.)
-SKIP_UNCHANGED_STYLE_WRITES = """
+# Three BokehJS costs paid on every paint, measured in Chromium on this machine (Bokeh 3.9; each
+# method is looked up first, and nothing is patched if it is not there; a browser test checks
+# that all three are active and that what they change still behaves as Bokeh's own code):
+#  * a plot component's stylesheet text is rewritten on every paint, nearly always with the text
+#    it already has, and each rewrite makes Chromium recollect the page's styles (about a fifth
+#    of the page's work per update). A rewrite that changes nothing is skipped.
+#  * every visual property read asks the CSS cascade for a `--bk-*` variable (three reads per
+#    `doit`, per tick label). The answers are kept until the running script returns (a
+#    microtask clears them): one paint asks once per property, the next paint asks again. This
+#    is the caching of bokeh/bokeh#15205 (after Bokeh 3.9); see also bokeh/bokeh#15286.
+#  * a glyph renderer places its (empty) DOM element over its data's bounding box by rewriting
+#    a stylesheet of its own; new data, new text, and Chromium re-parses the sheet and
+#    invalidates the styles of its whole tree scope: about 15 ms of style work per update. The
+#    same box is set as the element's inline style, which Chromium applies to that element
+#    alone.
+BOKEHJS_PAINT_PATCHES = """
 if (window.bushingStyleWrites == null) {
   const dom = Bokeh.require("core/dom")
   const sheet = dom != null && dom.InlineStyleSheet != null ? dom.InlineStyleSheet.prototype : null
@@ -63,6 +77,59 @@ if (window.bushingStyleWrites == null) {
     window.bushingStyleWrites = "skip-unchanged"
   } else {
     window.bushingStyleWrites = "unpatched"
+  }
+}
+if (window.bushingCssReads == null) {
+  const visual = Bokeh.require("core/visuals/visual")
+  const props = visual != null && visual.VisualProperties != null ? visual.VisualProperties.prototype : null
+  if (props != null && typeof props._get_css_value === "function") {
+    const read = props._get_css_value
+    props._get_css_value = function (name) {
+      if (this._bushing_css == null) {
+        this._bushing_css = new Map()
+        queueMicrotask(() => { this._bushing_css = null })
+      }
+      let value = this._bushing_css.get(name)
+      if (value === undefined) {
+        value = read.call(this, name)
+        this._bushing_css.set(name, value)
+      }
+      return value
+    }
+    window.bushingCssReads = "cached-per-task"
+  } else {
+    window.bushingCssReads = "unpatched"
+  }
+}
+if (window.bushingGlyphPosition == null) {
+  const glyph = Bokeh.require("models/renderers/glyph_renderer")
+  const view = glyph != null && glyph.GlyphRendererView != null ? glyph.GlyphRendererView.prototype : null
+  if (view != null && typeof view.update_position === "function") {
+    const update = view.update_position
+    view.update_position = function () {
+      if (this.panel != null || this.position == null) {
+        return update.call(this)
+      }
+      if (this._bushing_inline == null) {
+        this.position.replace("")  // once: what an earlier paint wrote there no longer applies
+        this._bushing_inline = true
+      }
+      const { bbox } = this
+      const style = this.el.style
+      if (bbox != null && bbox.is_valid) {
+        style.removeProperty("display")
+        style.position = "absolute"
+        style.left = `${bbox.left}px`
+        style.top = `${bbox.top}px`
+        style.width = `${bbox.width}px`
+        style.height = `${bbox.height}px`
+      } else {
+        style.display = "none"
+      }
+    }
+    window.bushingGlyphPosition = "inline-style"
+  } else {
+    window.bushingGlyphPosition = "unpatched"
   }
 }
 """
@@ -174,7 +241,7 @@ def create_app():
     app = App()
     app.sync_url()
     if pn.state.curdoc is not None:
-        pn.state.curdoc.js_on_event("document_ready", CustomJS(code=SKIP_UNCHANGED_STYLE_WRITES))
+        pn.state.curdoc.js_on_event("document_ready", CustomJS(code=BOKEHJS_PAINT_PATCHES))
     return app.template()
 
 

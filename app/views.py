@@ -78,18 +78,27 @@ class LogSlider(pn.viewable.Viewer):
             setattr(self._state, self._name, value)
 
     def _from_state(self, event):
-        """Move the slider to a value set elsewhere (a tap, a link, a preset); not back to the
-        4-digit rounding of its own value, which would send every move back to the browser."""
-        v = self._clip(math.log10(event.new))
-        if abs(v - self.slider.value) > self.slider.step / 2:
+        v = self._moved_to(event.new)
+        if v is not None:
             self.slider.value = v
 
-    def _rescale(self, _event):
+    def _moved_to(self, value):
+        """Where the slider must go to show a value set elsewhere (a tap, a link, a preset), or
+        None: not back to the 4-digit rounding of its own value, which would send every move
+        back to the browser."""
+        v = self._clip(math.log10(value))
         lo, hi = self._bounds()
-        self.slider.param.update(
-            start=math.log10(lo), end=math.log10(hi), label=self._label(),
-            value=self._clip(math.log10(getattr(self._state, self._name))),
-        )
+        inside = math.log10(lo) <= self.slider.value <= math.log10(hi)
+        return v if abs(v - self.slider.value) > self.slider.step / 2 or not inside else None
+
+    def _rescale(self, _event):
+        """New bounds (and unit) for a new design; Panel sends only what changed."""
+        lo, hi = self._bounds()
+        changes = {"start": math.log10(lo), "end": math.log10(hi), "label": self._label()}
+        v = self._moved_to(getattr(self._state, self._name))
+        if v is not None:
+            changes["value"] = v
+        self.slider.param.update(**changes)
 
     def __panel__(self):
         return pn.Row(self.slider, self.help, sizing_mode="stretch_width")

@@ -403,3 +403,45 @@ def test_the_slider_keeps_its_own_position(app):
     assert slider.value == -1.2345678
     app.state.amplitude = 0.5  # set elsewhere (a tap): the slider follows
     assert slider.value == pytest.approx(np.log10(0.5))
+    slider.value = -1.2345678
+    app.state.shear_modulus_mpa = 2.5  # a new design with the same amplitude bounds
+    assert slider.value == -1.2345678
+    app.state.friction_strain_half = app.state.friction_strain_half * 1000  # new bounds
+    lo, hi = app.state.amplitude_bounds
+    assert np.log10(lo) <= slider.value <= np.log10(hi)
+    assert abs(slider.value - np.log10(app.state.amplitude)) <= slider.step / 2
+
+
+def test_only_changed_data_are_sent(app):
+    """The operating amplitude changes the loop and the operating lines against frequency; the
+    sweeps (at fixed amplitudes and frequencies) and the curves against amplitude keep their
+    data objects, so nothing of them is sent and their plots are not repainted."""
+    def held():
+        return {(q, a, key): src.data for (q, a), fig in app.plots.figures.items()
+                for key, src in fig.sources.items()} | {("loop", key): src.data
+                                                        for key, src in app.plots.loop.sources.items()}
+    before = held()
+    app.state.amplitude = app.state.amplitude * 1.7
+    after = held()
+    changed = {key for key in before if after[key] is not before[key]}
+    expected = {("loop", name) for name in ("elastic", "viscoelastic", "friction", "total")}
+    expected |= {(q, "frequency", "operating") for q in ("magnitude", "loss_factor")}
+    assert changed == expected
+    fig = figure(app, "magnitude", "amplitude")
+    assert fig.marker.location == app.state.amplitude
+    assert fig.marker.level == "overlay"  # a moved marker repaints the overlay layer only
+
+
+def test_same_data_compares_values_nan_and_ragged_columns():
+    from app.figures import _same_data
+
+    a = {"x": np.array([1.0, np.nan]), "y": np.array([2.0, 3.0])}
+    assert _same_data(a, {"x": np.array([1.0, np.nan]), "y": np.array([2.0, 3.0])})
+    assert not _same_data(a, {"x": np.array([1.0, np.nan]), "y": np.array([2.0, 3.5])})
+    assert not _same_data(a, {"x": np.array([1.0]), "y": np.array([2.0])})
+    assert not _same_data(a, {"x": a["x"]})
+    ragged = {"xs": [np.arange(3.0), np.arange(2.0)], "color": ["red", "blue"]}
+    assert _same_data(ragged, {"xs": [np.arange(3.0), np.arange(2.0)], "color": ["red", "blue"]})
+    assert not _same_data(ragged, {"xs": [np.arange(3.0), np.arange(3.0)], "color": ["red", "blue"]})
+    assert not _same_data(ragged, {"xs": [np.arange(3.0), np.arange(2.0)], "color": ["red", "green"]})
+    assert _same_data({"x": []}, {"x": np.array([])})
