@@ -68,70 +68,55 @@ URL_DELAY_MS = 300
 #    same box is set as the element's inline style, which Chromium applies to that element
 #    alone.
 BOKEHJS_PAINT_PATCHES = """
-if (window.bushingStyleWrites == null) {
-  const dom = Bokeh.require("core/dom")
-  const sheet = dom != null && dom.InlineStyleSheet != null ? dom.InlineStyleSheet.prototype : null
-  if (sheet != null && typeof sheet._update === "function") {
-    const update = sheet._update
-    sheet._update = function (css) { if (this.el.textContent !== css) update.call(this, css) }
-    window.bushingStyleWrites = "skip-unchanged"
+// window[flag] says what happened: `done` if the method was found and wrapped, else "unpatched".
+const patch = (flag, done, module, cls, method, wrap) => {
+  if (window[flag] != null) return
+  const mod = Bokeh.require(module)
+  const proto = mod != null && mod[cls] != null ? mod[cls].prototype : null
+  if (proto != null && typeof proto[method] === "function") {
+    proto[method] = wrap(proto[method])
+    window[flag] = done
   } else {
-    window.bushingStyleWrites = "unpatched"
+    window[flag] = "unpatched"
   }
 }
-if (window.bushingCssReads == null) {
-  const visual = Bokeh.require("core/visuals/visual")
-  const props = visual != null && visual.VisualProperties != null ? visual.VisualProperties.prototype : null
-  if (props != null && typeof props._get_css_value === "function") {
-    const read = props._get_css_value
-    props._get_css_value = function (name) {
-      if (this._bushing_css == null) {
-        this._bushing_css = new Map()
-        queueMicrotask(() => { this._bushing_css = null })
-      }
-      let value = this._bushing_css.get(name)
-      if (value === undefined) {
-        value = read.call(this, name)
-        this._bushing_css.set(name, value)
-      }
-      return value
+patch("bushingStyleWrites", "skip-unchanged", "core/dom", "InlineStyleSheet", "_update", (update) =>
+  function (css) { if (this.el.textContent !== css) update.call(this, css) })
+patch("bushingCssReads", "cached-per-task", "core/visuals/visual", "VisualProperties", "_get_css_value", (read) =>
+  function (name) {
+    if (this._bushing_css == null) {
+      this._bushing_css = new Map()
+      queueMicrotask(() => { this._bushing_css = null })
     }
-    window.bushingCssReads = "cached-per-task"
-  } else {
-    window.bushingCssReads = "unpatched"
-  }
-}
-if (window.bushingGlyphPosition == null) {
-  const glyph = Bokeh.require("models/renderers/glyph_renderer")
-  const view = glyph != null && glyph.GlyphRendererView != null ? glyph.GlyphRendererView.prototype : null
-  if (view != null && typeof view.update_position === "function") {
-    const update = view.update_position
-    view.update_position = function () {
-      if (this.panel != null || this.position == null) {
-        return update.call(this)
-      }
-      if (this._bushing_inline == null) {
-        this.position.replace("")  // once: what an earlier paint wrote there no longer applies
-        this._bushing_inline = true
-      }
-      const { bbox } = this
-      const style = this.el.style
-      if (bbox != null && bbox.is_valid) {
-        style.removeProperty("display")
-        style.position = "absolute"
-        style.left = `${bbox.left}px`
-        style.top = `${bbox.top}px`
-        style.width = `${bbox.width}px`
-        style.height = `${bbox.height}px`
-      } else {
-        style.display = "none"
-      }
+    let value = this._bushing_css.get(name)
+    if (value === undefined) {
+      value = read.call(this, name)
+      this._bushing_css.set(name, value)
     }
-    window.bushingGlyphPosition = "inline-style"
-  } else {
-    window.bushingGlyphPosition = "unpatched"
-  }
-}
+    return value
+  })
+patch("bushingGlyphPosition", "inline-style", "models/renderers/glyph_renderer", "GlyphRendererView", "update_position", (update) =>
+  function () {
+    if (this.panel != null || this.position == null) {
+      return update.call(this)
+    }
+    if (this._bushing_inline == null) {
+      this.position.replace("")  // once: what an earlier paint wrote there no longer applies
+      this._bushing_inline = true
+    }
+    const { bbox } = this
+    const style = this.el.style
+    if (bbox != null && bbox.is_valid) {
+      style.removeProperty("display")
+      style.position = "absolute"
+      style.left = `${bbox.left}px`
+      style.top = `${bbox.top}px`
+      style.width = `${bbox.width}px`
+      style.height = `${bbox.height}px`
+    } else {
+      style.display = "none"
+    }
+  })
 """
 
 
