@@ -8,12 +8,12 @@ import json
 import numpy as np
 import param
 
-from core.data import DataError, MeasuredStiffness, csv_text, parse_stiffness
+from core.data import MeasuredStiffness, csv_text, parse_stiffness
 from core.diagnose import BRANCHES, Diagnosis, diagnose
 from core.effects import EFFECTS
 from core.synthetic import MYSTERIES, Mystery
 
-from .state import AMPLITUDE_DISPLAY, STIFFNESS_DISPLAY, ExplorerState
+from .state import AMPLITUDE_DISPLAY, STIFFNESS_DISPLAY, ExplorerState, read_measured
 
 
 class DiagnosisState(param.Parameterized):
@@ -45,10 +45,9 @@ class DiagnosisState(param.Parameterized):
         self.param.update(data=data, source=source, result=None, message="", mystery=mystery, revealed=False)
 
     def load_csv(self, content: bytes | str, filename: str = "stiffness file") -> bool:
-        try:
-            data = parse_stiffness(content)
-        except DataError as exc:
-            self.message = f"{filename}: {exc}"
+        data, message = read_measured(parse_stiffness, content, filename)
+        if data is None:
+            self.message = message
             return False
         self._set_data(data, filename)
         return True

@@ -72,6 +72,15 @@ def _number(doc, label, default, **kw):
     return param.Number(default, allow_None=True, label=label, doc=doc, **kw)
 
 
+def read_measured(parse, content: bytes | str, filename: str):
+    """``(parse(content), "")``, or ``(None, message)`` naming the file and what is wrong with it
+    (a file the formats of FORMATS.md refuse)."""
+    try:
+        return parse(content), ""
+    except DataError as exc:
+        return None, f"{filename}: {exc}"
+
+
 class ExplorerState(param.Parameterized):
     """One user's design session: inputs, the operating point, the pinned reference."""
 
@@ -205,25 +214,25 @@ class ExplorerState(param.Parameterized):
 
     def load_measured(self, content: bytes | str, filename: str = "stiffness file") -> bool:
         """Read a measured-stiffness CSV (FORMATS.md); on a bad file say why and keep the last."""
-        try:
-            data = parse_stiffness(content)
-        except DataError as exc:
-            self.data_message = f"{filename}: {exc}"
+        data, self.data_message = read_measured(parse_stiffness, content, filename)
+        if data is None:
             return False
-        self.param.update(measured=data, data_message="", fit_result=None)
+        self.param.update(measured=data, fit_result=None)
         return True
 
     def load_measured_loop(self, content: bytes | str, filename: str = "loop file") -> bool:
         """Read a measured-loop CSV; the operating point moves to the loop's frequency and
         amplitude, so that the model's loop is drawn over the measured one."""
-        try:
-            data = parse_loop(content)
-            f, amp, _ = data.harmonic()
-        except DataError as exc:
-            self.data_message = f"{filename}: {exc}"
+        def parse(text):
+            loop = parse_loop(text)
+            return loop, loop.harmonic()
+
+        read, self.data_message = read_measured(parse, content, filename)
+        if read is None:
             return False
+        data, (f, amp, _) = read
         x = float(self.display_amplitude(amp))
-        self.param.update(measured_loop=data, data_message="", fit_result=None,
+        self.param.update(measured_loop=data, fit_result=None,
                           frequency_hz=float(np.clip(f, *FREQUENCY_BOUNDS)), amplitude=float(f"{x:.4g}"))
         return True
 
