@@ -20,6 +20,7 @@ from .views import (
     DesignInputs,
     ExplorerPlots,
     ExportView,
+    PlotView,
     SlicesView,
     TeachingView,
     status_banner,
@@ -135,36 +136,62 @@ for _name in URL_NAMES:
 
 
 class App(pn.viewable.Viewer):
-    """One session of the explorer: its own state, inputs, plots and URL."""
+    """One session of the explorer: its own state, inputs, plots and URL.
+
+    The views of the other tabs are built when their tab is first opened (or when code asks
+    for them): a page load builds only what it shows. Measured on this machine, building every
+    tab's figures took about half of the server's time to answer a first request."""
+
+    # tab title, attribute, builder; the Explorer tab (0) and About are built at once
+    LAZY_TABS = (
+        ("Slices", "slices", lambda app: SlicesView(app.state)),
+        ("Fletcher–Gent, branch by branch", "teaching", lambda app: TeachingView(app.state)),
+        ("Measured data and fit", "measured", lambda app: MeasuredView(app.state)),
+        ("Find the missing effect", "diagnosis", lambda app: DiagnosisView(DiagnosisState(app.state))),
+    )
 
     def __init__(self, state: ExplorerState | None = None, **params):
         super().__init__(**params)
         self.state = state or ExplorerState()
         self.inputs = DesignInputs(self.state)
         self.plots = ExplorerPlots(self.state)
-        self.slices = SlicesView(self.state)
-        self.teaching = TeachingView(self.state)
-        self.measured = MeasuredView(self.state)
-        self.diagnosis = DiagnosisView(DiagnosisState(self.state))
         self.compare = CompareView(self.state)
         self.export = ExportView(self.state)
+        self._built: dict[str, pn.viewable.Viewer] = {}
+        self._holders = {name: pn.Column(sizing_mode="stretch_width") for _title, name, _build in self.LAZY_TABS}
         self.tabs = pn.Tabs(
             ("Explorer", pn.Column(self.compare, self.plots, sizing_mode="stretch_width")),
-            ("Slices", self.slices),
-            ("Fletcher–Gent, branch by branch", self.teaching),
-            ("Measured data and fit", self.measured),
-            ("Find the missing effect", self.diagnosis),
+            *((title, self._holders[name]) for title, name, _build in self.LAZY_TABS),
             ("About", pn.pane.Markdown(ABOUT, sizing_mode="stretch_width")),
             dynamic=True,
             sizing_mode="stretch_width",
         )
-        self._tab_views = {0: self.plots, 1: self.slices, 2: self.teaching, 3: self.measured}
         self.tabs.param.watch(self._on_tab, "active")
         self._on_tab()
 
+    slices = property(lambda self: self.view("slices"))
+    teaching = property(lambda self: self.view("teaching"))
+    measured = property(lambda self: self.view("measured"))
+    diagnosis = property(lambda self: self.view("diagnosis"))
+
+    def view(self, name: str):
+        """The view of a lazily built tab, built (and put in its tab) on first use."""
+        if name not in self._built:
+            build = next(b for _title, n, b in self.LAZY_TABS if n == name)
+            self._built[name] = build(self)
+            self._holders[name].objects = [self._built[name]]
+            self._on_tab()
+        return self._built[name]
+
     def _on_tab(self, *_events):
-        for index, view in self._tab_views.items():
-            view.show(index == self.tabs.active)
+        active = self.tabs.active
+        if 1 <= active <= len(self.LAZY_TABS):
+            self.view(self.LAZY_TABS[active - 1][1])
+        self.plots.show(active == 0)
+        for index, (_title, name, _build) in enumerate(self.LAZY_TABS, start=1):
+            view = self._built.get(name)
+            if isinstance(view, PlotView):
+                view.show(index == active)
 
     def sync_url(self, delay_ms: int = URL_DELAY_MS):
         """Put the whole design in the URL, and read one from it (a shared link)."""

@@ -230,7 +230,13 @@ def test_a_failing_refresh_keeps_the_last_plots_and_logs_one_line(app, caplog):
     assert "ZeroDivisionError" in caplog.records[0].getMessage()
 
 
-def test_hidden_tabs_catch_up_when_shown(app):
+def test_other_tabs_are_built_when_opened_and_catch_up_when_shown(app):
+    assert [len(app.tabs[i].objects) for i in range(1, 5)] == [0, 0, 0, 0]  # a load builds the Explorer
+    app.tabs.active = 2
+    assert len(app.tabs[2].objects) == 1
+    assert len(app.tabs[1].objects) == 0
+    app.tabs.active = 0
+    assert app.slices is app.slices and len(app.tabs[1].objects) == 1  # built once, on demand
     app.state.shear_modulus_mpa = 3.0  # the Slices tab is hidden: not refreshed yet
     stale = np.asarray(app.slices.figures["magnitude"].sources["1"].data["y"]).copy()
     app.tabs.active = 1
