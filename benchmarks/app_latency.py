@@ -43,8 +43,8 @@ ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking", "--d
         "--disable-sync", "--no-first-run", "--disable-quic", "--disable-background-timer-throttling",
         "--disable-renderer-backgrounding", "--disable-backgrounding-occluded-windows"]
 
-READY_JS = """() => window.Bokeh && Bokeh.documents.length > 0 && Bokeh.documents[0].is_idle &&
-  [...Bokeh.documents[0].all_models].filter(m => m.type === 'Figure').length >= 5"""
+READY_JS = """(figures) => window.Bokeh && Bokeh.documents.length > 0 && Bokeh.documents[0].is_idle &&
+  [...Bokeh.documents[0].all_models].filter(m => m.type === 'Figure').length >= figures"""
 
 # Change a widget's model and time until the last change to a plot (its data, ranges, marker,
 # legend or axes) has been painted; the URL and text panes updating later do not count.
@@ -107,15 +107,16 @@ def free_port():
         return s.getsockname()[1]
 
 
-def start_server(port):
+def start_server(port, command=None, probe="/liveness"):
+    """Start the explorer (or ``command``, another server) and wait until ``probe`` answers."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", "core.cli", "serve", "--port", str(port)],
+        command or [sys.executable, "-m", "core.cli", "serve", "--port", str(port)],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )
     deadline = time.time() + 60
     while time.time() < deadline:
         try:
-            with urllib.request.urlopen(f"http://localhost:{port}/liveness", timeout=2):
+            with urllib.request.urlopen(f"http://localhost:{port}{probe}", timeout=5):
                 return proc
         except OSError:
             time.sleep(0.2)
@@ -139,11 +140,11 @@ def changes(n):
     return out
 
 
-async def open_page(browser, url):
+async def open_page(browser, url, figures=5):
     page = await browser.new_page(viewport={"width": 1500, "height": 1300})
     t0 = time.perf_counter()
     await page.goto(url)
-    await page.wait_for_function(READY_JS, timeout=60000, polling=20)
+    await page.wait_for_function(READY_JS, arg=figures, timeout=60000, polling=20)
     return page, time.perf_counter() - t0
 
 
@@ -167,44 +168,54 @@ def report(name, ms, target):
           f"   max {max(ms):6.0f} ms   ({target})")
 
 
+async def measure(url, server_pid, n_changes, n_sessions, figures=5) -> dict:
+    """Run the whole protocol on the page at ``url`` (``figures`` plots, served by process
+    ``server_pid``), print each figure and return them (milliseconds; the load in seconds)."""
+    out = {}
+    async with async_playwright() as p:
+        browser = await p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        loads = []
+        for _ in range(3):
+            page, seconds = await open_page(browser, url, figures)
+            loads.append(seconds)
+            await page.close()
+        out["load"] = statistics.median(loads)
+        print(f"{'first page load':<34} n={len(loads):>3}  median {out['load']:6.2f} s    "
+              f"max {max(loads):.2f} s   (target ≤ 3 s)")
+        page, _ = await open_page(browser, url, figures)
+        await run_changes(page, 4)  # warm-up
+        out["one"] = await run_changes(page, n_changes)
+        report("one session, widget → all plots", out["one"], "target median ≤ 150 ms, p95 ≤ 300 ms")
+        await page.close()
+        pages = [(await open_page(browser, url, figures))[0] for _ in range(n_sessions)]
+        for pg in pages:
+            await run_changes(pg, 2)
+        # rounds: every session changes a widget at the same moment, then a person's pause
+        rounds = []
+        server0, chromium0 = cpu_seconds(server_pid), chromium_cpu()
+        for _ in range(max(10, n_changes // 2)):
+            rounds += await asyncio.gather(*(run_changes(pg, 1) for pg in pages))
+            await asyncio.sleep(0.5)
+        server1, chromium1 = cpu_seconds(server_pid), chromium_cpu()
+        out["many"] = [v for r in rounds for v in r]
+        report(f"{n_sessions} sessions, simultaneous rounds", out["many"], "target p95 ≤ 500 ms")
+        n = len(out["many"])
+        out["cpu"] = {"server": 1000 * (server1 - server0) / n}
+        out["cpu"].update({k: 1000 * (chromium1[k] - chromium0.get(k, 0.0)) / n for k in sorted(chromium1)
+                           if chromium1[k] - chromium0.get(k, 0.0) > 0})
+        print(f"{'  CPU per change (ms)':<34} " + ", ".join(f"{k} {v:.0f}" for k, v in out["cpu"].items()))
+        # back to back: each session changes again as soon as its plots are drawn (saturation)
+        results = await asyncio.gather(*(run_changes(pg, max(10, n_changes // 2)) for pg in pages))
+        report(f"{n_sessions} sessions, back to back", [v for r in results for v in r], "saturation, for reference")
+        await browser.close()
+    return out
+
+
 async def main(n_changes, n_sessions):
     port = free_port()
     server = start_server(port)
-    url = f"http://localhost:{port}/"
     try:
-        async with async_playwright() as p:
-            browser = await p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-            loads = []
-            for _ in range(3):
-                page, seconds = await open_page(browser, url)
-                loads.append(seconds)
-                await page.close()
-            print(f"{'first page load':<34} n={len(loads):>3}  median {statistics.median(loads):6.2f} s    "
-                  f"max {max(loads):.2f} s   (target ≤ 3 s)")
-            page, _ = await open_page(browser, url)
-            await run_changes(page, 4)  # warm-up
-            report("one session, widget → all plots", await run_changes(page, n_changes),
-                   "target median ≤ 150 ms, p95 ≤ 300 ms")
-            await page.close()
-            pages = [(await open_page(browser, url))[0] for _ in range(n_sessions)]
-            for pg in pages:
-                await run_changes(pg, 2)
-            # rounds: every session changes a widget at the same moment, then a person's pause
-            rounds = []
-            server0, chromium0 = cpu_seconds(server.pid), chromium_cpu()
-            for _ in range(max(10, n_changes // 2)):
-                rounds += await asyncio.gather(*(run_changes(pg, 1) for pg in pages))
-                await asyncio.sleep(0.5)
-            server1, chromium1 = cpu_seconds(server.pid), chromium_cpu()
-            report(f"{n_sessions} sessions, simultaneous rounds", [v for r in rounds for v in r], "target p95 ≤ 500 ms")
-            n = sum(len(r) for r in rounds)
-            kinds = ", ".join(f"{k} {1000 * (chromium1[k] - chromium0.get(k, 0.0)) / n:.0f}"
-                              for k in sorted(chromium1) if chromium1[k] - chromium0.get(k, 0.0) > 0)
-            print(f"{'  CPU per change (ms)':<34} server {1000 * (server1 - server0) / n:.0f}; Chromium: {kinds}")
-            # back to back: each session changes again as soon as its plots are drawn (saturation)
-            results = await asyncio.gather(*(run_changes(pg, max(10, n_changes // 2)) for pg in pages))
-            report(f"{n_sessions} sessions, back to back", [v for r in results for v in r], "saturation, for reference")
-            await browser.close()
+        await measure(f"http://localhost:{port}/", server.pid, n_changes, n_sessions)
     finally:
         server.terminate()
         server.wait(10)
