@@ -212,6 +212,8 @@ class Figure:
         self._line_colors: dict[str, list[str]] = {}
         self._items: dict[str, list[LegendItem]] = {}
         self.legend = None
+        # the one NaN point that every legend proxy of this figure draws (one source, not one each)
+        self._proxy_source = ColumnDataSource({c: [np.nan] for c in ("x", "y", "y1", "y2")})
         if legend:
             self.legend = Legend(items=[], location="top_left" if legend == "inside" else "center",
                                  click_policy="hide", label_text_font_size="11px",
@@ -239,7 +241,7 @@ class Figure:
         self.sources[key] = src
         self.renderers[key] = draw(src)
         if label is not None and self.legend is not None:
-            proxy = draw(ColumnDataSource({c: [np.nan] for c in columns}))
+            proxy = draw(self._proxy_source)
             self._follow["proxies"].append(proxy)
             self._follow["targets"].append(self.renderers[key])
             self._add_item(key, label, proxy)
@@ -294,7 +296,7 @@ class Figure:
         if self.legend is not None and labels:
             shown = IndexFilter(indices=list(range(len(labels))))
             renderer.view = CDSView(filter=shown)
-            proxies = [self.fig.line(x=[np.nan], y=[np.nan], line_color=colors[i % len(colors)], **style)
+            proxies = [self.fig.line("x", "y", source=self._proxy_source, line_color=colors[i % len(colors)], **style)
                        for i in range(len(labels))]
             self._follow["filters"].append(shown)
             self._follow["line_proxies"].append(proxies)

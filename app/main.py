@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import logging
 import os
+import re
 import sys
 
 import panel as pn
 import param
 from bokeh.models import CustomJS
+from panel.io import resources as panel_resources
+from panel.models.markup import HTML as PanelHTML
 
 from .diagnosis import DiagnosisView
 from .diagnosis_state import DiagnosisState
@@ -31,6 +34,23 @@ from .views import (
 # template's), and Bokeh re-collected every model of the document each time: measured with
 # several sessions, ~9 ms of the server per change.
 pn.extension(throttled=False)
+
+
+# Panel 1.9 sends Bokeh's MathJax bundle (1.8 MB, the largest script of the page) whenever the
+# page holds an HTML pane, in case one holds math (holoviz/panel#8424; holoviz/panel#8179 would
+# load it late instead). The explorer's texts hold none: the bundle is sent only to a page whose
+# texts have math delimiters. Measured here: about 0.1 s of each page load.
+MATH_DELIMITERS = re.compile(r"\$\$|\\\(|\\\[")
+
+
+def holds_math(roots) -> bool:
+    """Whether any Panel HTML model under ``roots`` has text with math delimiters."""
+    return any(isinstance(model, PanelHTML) and MATH_DELIMITERS.search(model.text or "")
+               for root in roots for model in root.references())
+
+
+if hasattr(panel_resources, "_panel_use_mathjax"):
+    panel_resources._panel_use_mathjax = holds_math
 
 TITLE = "Bushing Explorer"
 

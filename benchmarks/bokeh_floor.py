@@ -21,7 +21,6 @@ import statistics
 import sys
 
 import numpy as np
-
 from app_latency import free_port, measure, pct, start_server
 
 N_CURVES, N_POINTS = 5, 200

@@ -37,6 +37,23 @@ def test_factory_builds_a_fresh_session_each_time():
     assert s2.shear_modulus_mpa == 2.42  # sessions never share state
 
 
+def test_the_page_gets_the_mathjax_script_only_if_a_text_holds_math():
+    import panel as pn
+    from bokeh.document import Document
+    from panel.io.resources import Resources, bundle_resources
+
+    def scripts(viewable):
+        doc = Document()
+        viewable.server_doc(doc)
+        return [str(f).split("?")[0].rsplit("/", 1)[-1] for f in bundle_resources(doc.roots, Resources(mode="server")).js_files]
+
+    explorer = scripts(create_app())
+    assert {"bokeh.min.js", "bokeh-widgets.min.js", "panel.min.js"} <= set(explorer)
+    assert "bokeh-mathjax.min.js" not in explorer
+    assert "bokeh-mathjax.min.js" in scripts(pn.Column(pn.pane.Markdown("Energy $$E = mc^2$$")))
+    assert "bokeh-mathjax.min.js" not in scripts(pn.Column(pn.pane.Markdown("It costs $5, or $6.")))
+
+
 def test_defaults_are_the_paper_b_bushing(app):
     assert app.state.design == PAPER_B
     assert app.state.errors == {}
