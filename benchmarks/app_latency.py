@@ -9,8 +9,10 @@ Starts `bushing serve` on a free port, opens the explorer in the system Chromium
   the server) to the last plot update painted (the last document change, then an animation
   frame), over many changes of the shear modulus and the drive amplitude;
 * N sessions at once: N pages changing a widget at the same moment, round after round with a
-  person's pause (0.5 s) between rounds; and, for reference, N pages changing back to back
-  (each as soon as its last change is drawn), which saturates the machine.
+  person's pause (0.5 s) between rounds; and, for reference, N pages each changing at its own
+  pace (a pause of 0.5–1.5 s drawn for each change, so changes overlap as they happen to), and
+  N pages changing back to back (each as soon as its last change is drawn), which saturates the
+  machine.
 
 All N pages run in one Chromium on this same 2-core machine as the server, so the pages'
 rendering competes with the server for the CPU; users on their own machines would not. For the
@@ -26,6 +28,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import os
+import random
 import shutil
 import socket
 import statistics
@@ -204,6 +207,17 @@ async def measure(url, server_pid, n_changes, n_sessions, figures=5) -> dict:
         out["cpu"].update({k: 1000 * (chromium1[k] - chromium0.get(k, 0.0)) / n for k in sorted(chromium1)
                            if chromium1[k] - chromium0.get(k, 0.0) > 0})
         print(f"{'  CPU per change (ms)':<34} " + ", ".join(f"{k} {v:.0f}" for k, v in out["cpu"].items()))
+        # at a person's own pace: each session waits 0.5–1.5 s (its own seeded draws) between
+        # changes, so changes overlap as they come, not all at one moment
+        async def own_pace(page, rng):
+            out = []
+            for _ in range(max(5, n_changes // 4)):
+                await asyncio.sleep(rng.uniform(0.5, 1.5))
+                out += await run_changes(page, 1)
+            return out
+
+        paced = await asyncio.gather(*(own_pace(pg, random.Random(i)) for i, pg in enumerate(pages)))
+        report(f"{n_sessions} sessions, each at its own pace", [v for r in paced for v in r], "for reference")
         # back to back: each session changes again as soon as its plots are drawn (saturation)
         results = await asyncio.gather(*(run_changes(pg, max(10, n_changes // 2)) for pg in pages))
         report(f"{n_sessions} sessions, back to back", [v for r in results for v in r], "saturation, for reference")
