@@ -21,6 +21,7 @@ from . import plots
 from .diagnosis_state import DiagnosisState
 from .figures import Axis, Figure
 from .state import AMPLITUDE_DISPLAY, STIFFNESS_DISPLAY
+from .views import update_or_keep
 
 log = logging.getLogger("bushing.app")
 
@@ -198,11 +199,7 @@ class DiagnosisView(pn.viewable.Viewer):
     # ---- refresh -------------------------------------------------------------------------------
 
     def _refresh(self, *_events):
-        try:
-            with pn.io.hold():
-                self._update()
-        except Exception as exc:  # noqa: BLE001 - keep the last view, say it in the log
-            log.warning("DiagnosisView kept its last view: %s: %s", type(exc).__name__, exc)
+        update_or_keep("DiagnosisView kept its last view", self._update)
 
     def _update(self):
         s = self.state
@@ -278,12 +275,8 @@ class DiagnosisView(pn.viewable.Viewer):
             for g, c in zip(curves, colours))
         for i, quantity in enumerate(("magnitude", "loss")):
             fig = self.curve_figs[quantity]
-            for which in ("baseline", "final"):
-                fig.sources[which].data = {
-                    "xs": [g["frequency_hz"] for g in curves],
-                    "ys": [g[which][i] for g in curves],
-                    "color": colours,
-                }
+            for which in ("baseline", "final"):  # through the figure: its ranges take the curves in
+                fig.set_lines(which, None, [g[which][i] for g in curves], each_x=[g["frequency_hz"] for g in curves])
             fig.set("data", x=np.concatenate([g["frequency_hz"] for g in curves]),
                     y=np.concatenate([g["data"][i] for g in curves]),
                     color=[c for g, c in zip(curves, colours) for _ in g["frequency_hz"]])

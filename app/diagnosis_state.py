@@ -3,12 +3,10 @@ plots' data. No Panel import: the view (:mod:`app.diagnosis`) is thin."""
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import param
 
-from core.data import MeasuredStiffness, csv_text, parse_stiffness
+from core.data import MeasuredStiffness, csv_text, loss_factor, parse_stiffness
 from core.diagnose import BRANCHES, Diagnosis, diagnose
 from core.effects import EFFECTS
 from core.synthetic import MYSTERIES, Mystery
@@ -84,10 +82,8 @@ class DiagnosisState(param.Parameterized):
         """Take the final model into the explorer, keeping the operating point."""
         if self.result is None:
             return
-        amplitude, frequency = self.explorer.amplitude, self.explorer.frequency_hz
         design = self.result.final.design
-        self.explorer.load_design(design.replace(name=f"{self.explorer.design.name or 'Design'} (diagnosed)"))
-        self.explorer.param.update(amplitude=amplitude, frequency_hz=frequency)
+        self.explorer.adopt(design.replace(name=f"{self.explorer.design.name or 'Design'} (diagnosed)"))
 
     def truth(self) -> str:
         """The demo's truth in words, and whether the diagnosis found it."""
@@ -129,7 +125,7 @@ class DiagnosisState(param.Parameterized):
             "frequency_hz": d.frequency_hz,
             "amplitude": d.amplitude / AMPLITUDE_DISPLAY[r.final.design.mode][1],
             "magnitude_pct": 100 * (np.abs(k) / d.magnitude - 1),
-            "loss_factor": k.imag / k.real - d.loss_factor,
+            "loss_factor": loss_factor(k) - d.loss_factor,
         }
 
     def curves(self) -> dict:
@@ -137,8 +133,7 @@ class DiagnosisState(param.Parameterized):
         populated five), display units."""
         r = self.result
         d = r.data
-        values, counts = np.unique(d.amplitude, return_counts=True)
-        chosen = np.sort(values[np.argsort(-counts, kind="stable")][:5])
+        chosen = np.sort(d.amplitudes()[:5])
         groups = []
         mode = r.final.design.mode
         x_unit, k_unit = AMPLITUDE_DISPLAY[mode][1], STIFFNESS_DISPLAY[mode][1]
@@ -149,16 +144,16 @@ class DiagnosisState(param.Parameterized):
             groups.append({
                 "amplitude": float(amp / x_unit),
                 "frequency_hz": d.frequency_hz[sel],
-                "data": (np.abs(kd) / k_unit, kd.imag / kd.real),
-                "baseline": (np.abs(kb) / k_unit, kb.imag / kb.real),
-                "final": (np.abs(kf) / k_unit, kf.imag / kf.real),
+                "data": (np.abs(kd) / k_unit, loss_factor(kd)),
+                "baseline": (np.abs(kb) / k_unit, loss_factor(kb)),
+                "final": (np.abs(kf) / k_unit, loss_factor(kf)),
             })
         return {"groups": groups}
 
     # ---- downloads -----------------------------------------------------------------------------
 
     def report_json(self) -> str:
-        return json.dumps(self.result.report(), indent=2, allow_nan=False) + "\n" if self.result else ""
+        return self.result.to_json() if self.result is not None else ""
 
     def predictions_csv(self) -> str:
         return csv_text(self.result.predictions()) if self.result is not None else ""

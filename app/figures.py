@@ -304,12 +304,13 @@ class Figure:
                 self._add_item(key, label, proxy)
         return renderer
 
-    def set_lines(self, key: str, x, ys, labels: list[str]):
-        """Replace the lines of :meth:`lines` (all on the same x) and relabel them if needed."""
+    def set_lines(self, key: str, x, ys, labels: list[str] = (), *, each_x=None):
+        """Replace the lines of :meth:`lines`, all on ``x`` (or each on its own: ``each_x``, one
+        array per line, with ``x`` None), and relabel them if needed."""
         colors = self._line_colors[key]
-        x = np.asarray(x, dtype=float)
+        xs = [np.asarray(v, dtype=float) for v in each_x] if each_x is not None else [np.asarray(x, dtype=float)] * len(ys)
         data = {
-            "xs": [x] * len(ys),
+            "xs": xs,
             "ys": [np.asarray(y, dtype=float) for y in ys],
             "color": [colors[i % len(colors)] for i in range(len(ys))],
         }

@@ -29,10 +29,6 @@ from .views import (
     status_banner,
 )
 
-# Every component is styled by the template's design from the start. With Panel's default
-# design, each update of a pane re-sent the pane's stylesheets (the default theme's, then the
-# template's), and Bokeh re-collected every model of the document each time: measured with
-# several sessions, ~9 ms of the server per change.
 pn.extension(throttled=False)
 
 

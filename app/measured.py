@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import asyncio
 import io
-import json
 import logging
 
 import numpy as np
@@ -13,7 +12,7 @@ import panel as pn
 
 from core import PAPER_B
 from core.fit import PARAMETERS
-from core.synthetic import loop_csv, paper_b_example
+from core.synthetic import paper_b_example
 
 from . import plots
 from .figures import AutoRange, Axis, Figure
@@ -92,22 +91,19 @@ class MeasuredView(PlotView):
     def _load_example(self, _event):
         data, loop = paper_b_example(PAPER_B)
         self.state.load_measured(data.to_csv(), "paper_b_stiffness.csv")
-        self.state.load_measured_loop(loop_csv(loop), "paper_b_loop.csv")
+        self.state.load_measured_loop(loop.to_csv(), "paper_b_loop.csv")
 
     async def _fit(self, _event):
         self.fit_button.loading = True
         try:
-            result = await asyncio.to_thread(self.state.compute_fit)  # the server stays responsive
-        except ValueError as exc:
-            self.state.data_message = str(exc)
-        else:
-            self.state.fit_result = result
+            # computed in a worker (the server stays responsive), stored here in the session
+            self.state.store_fit(await asyncio.to_thread(self.state.try_fit))
         finally:
             self.fit_button.loading = False
 
     def _fitted_json(self):
         r = self.state.fit_result
-        return io.StringIO(json.dumps(r.to_dict(), indent=2) + "\n") if r is not None else io.StringIO("")
+        return io.StringIO(r.to_json() if r is not None else "")
 
     def _set_axes(self, axes):
         for (_quantity, which), fig in self.figures.items():
@@ -118,13 +114,13 @@ class MeasuredView(PlotView):
         s = self.state
         self.message.object = (f'<div class="data-error" style="color:#b03a2e">⚠ {s.data_message}</div>'
                                if s.data_message else "")
-        points = s.measured_points()
+        points, residuals = s.measured_points(), s.measured_residuals()
         lines = []
         if s.measured is not None:
             d = s.measured
             lines.append(f"**Stiffness**: {len(d)} points, {d.frequency_hz.min():.3g}–{d.frequency_hz.max():.3g} Hz, "
                          f"amplitudes {points['amplitude'].min():.3g}–{points['amplitude'].max():.3g} {s.amplitude_unit}; "
-                         f"gap of the current design: **{points['gap']:.4f}**")
+                         f"gap of the current design: **{residuals['gap']:.4f}**")
         if s.measured_loop is not None:
             f, amp, _ = s.measured_loop.harmonic()
             lines.append(f"**Loop**: {s.measured_loop.time_s.size} samples at {f:.3g} Hz, amplitude "
@@ -134,7 +130,7 @@ class MeasuredView(PlotView):
             if points is None:
                 fig.clear("points")
                 continue
-            y = points["magnitude_residual_pct"] if quantity == "magnitude" else points["loss_factor_residual"]
+            y = residuals["magnitude_residual_pct" if quantity == "magnitude" else "loss_factor_residual"]
             fig.set("points", x=points["frequency_hz" if which == "frequency" else "amplitude"], y=y)
         options = {f"{s.display_amplitude(a):.4g} {s.amplitude_unit}": a for a in s.measured_amplitudes()}
         if options != self.sweep.options:

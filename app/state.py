@@ -22,7 +22,14 @@ from core.bushing import (
     stiffness_points,
     strain_factor,
 )
-from core.data import DataError, MeasuredLoop, MeasuredStiffness, parse_loop, parse_stiffness
+from core.data import (
+    DataError,
+    MeasuredLoop,
+    MeasuredStiffness,
+    loss_factor,
+    parse_loop,
+    parse_stiffness,
+)
 from core.design import as_dict
 from core.fit import FitResult, fit_global, fit_two_step, gap
 from core.material import ConvergenceError
@@ -243,12 +250,11 @@ class ExplorerState(param.Parameterized):
         """The distinct measured amplitudes (SI), most frequent first."""
         if self.measured is None:
             return []
-        values, counts = np.unique(self.measured.amplitude, return_counts=True)
-        return [float(v) for v in values[np.argsort(-counts, kind="stable")]]
+        return [float(v) for v in self.measured.amplitudes()]
 
     def compute_fit(self) -> FitResult:
         """Fit the five material parameters to the measured data (the current design is the
-        first start). Pure: safe to run in a worker thread; :meth:`run_fit` stores it."""
+        first start). Pure: safe to run in a worker thread; :meth:`store_fit` stores it."""
         if self.measured is None and self.measured_loop is None:
             raise ValueError("load measured stiffness (and optionally a loop) first")
         if self.fit_method == "two-step":
@@ -262,34 +268,55 @@ class ExplorerState(param.Parameterized):
             return fit_two_step(self.design, self.measured_loop, sweep)
         return fit_global(self.design, self.measured, self.measured_loop)
 
-    def run_fit(self):
+    def try_fit(self) -> FitResult | str:
+        """:meth:`compute_fit`, or why it cannot run (pure: safe in a worker thread)."""
         try:
-            self.fit_result = self.compute_fit()
-            self.data_message = ""
+            return self.compute_fit()
         except ValueError as exc:
-            self.data_message = str(exc)
+            return str(exc)
+
+    def store_fit(self, outcome: FitResult | str):
+        """Keep a fit (and forget an earlier message), or say why there is none."""
+        if isinstance(outcome, FitResult):
+            self.param.update(fit_result=outcome, data_message="")
+        else:
+            self.data_message = outcome
+
+    def run_fit(self):
+        self.store_fit(self.try_fit())
 
     def use_fit(self):
         """Take the fitted design into the explorer, keeping the operating point."""
-        if self.fit_result is None:
-            return
+        if self.fit_result is not None:
+            self.adopt(self.fit_result.design)
+
+    def adopt(self, design: Design):
+        """Show ``design`` (a fit, a diagnosis) at the operating point the user had."""
         amplitude, frequency = self.amplitude, self.frequency_hz
-        self.load_design(self.fit_result.design)
+        self.load_design(design)
         self.param.update(amplitude=amplitude, frequency_hz=frequency)
 
     def measured_points(self) -> dict | None:
-        """Measured points in display units, the model at each, and the residuals."""
+        """Measured points in display units (as the data are: no model here)."""
         d = self.measured
         if d is None:
             return None
-        k_model = stiffness_points(self.design, d.frequency_hz, d.amplitude)
         return {
             "frequency_hz": d.frequency_hz,
             "amplitude": self.display_amplitude(d.amplitude),
             "magnitude": self._stiffness_display(d.magnitude),
             "loss_factor": d.loss_factor,
+        }
+
+    def measured_residuals(self) -> dict | None:
+        """The design at each measured point against the data: |K| in %, the loss factor, the gap."""
+        d = self.measured
+        if d is None:
+            return None
+        k_model = stiffness_points(self.design, d.frequency_hz, d.amplitude)
+        return {
             "magnitude_residual_pct": 100 * (np.abs(k_model) / d.magnitude - 1),
-            "loss_factor_residual": k_model.imag / k_model.real - d.loss_factor,
+            "loss_factor_residual": loss_factor(k_model) - d.loss_factor,
             "gap": gap(k_model, d.stiffness),
         }
 

@@ -182,6 +182,16 @@ def _axes(mode):
     }
 
 
+def update_or_keep(what: str, update) -> None:
+    """Run ``update`` holding the document (its changes go as one message). It never raises:
+    an unexpected error keeps what is shown and is logged in one line, with ``what`` was kept."""
+    try:
+        with pn.io.hold():
+            update()
+    except Exception as exc:  # noqa: BLE001 - keep the last view, say what happened
+        log.warning("%s: %s: %s", what, type(exc).__name__, exc)
+
+
 class PlotView(pn.viewable.Viewer):
     """Figures refreshed together, in one message, when the state parameters they show change.
     A refresh never raises: an unexpected error is logged in one line and the last plots stay."""
@@ -214,15 +224,14 @@ class PlotView(pn.viewable.Viewer):
             self.refresh()
 
     def refresh(self):
-        try:
-            with pn.io.hold():
-                mode = self.state.design.mode
-                if mode != self._mode:
-                    self._mode = mode
-                    self._set_axes(_axes(mode))
-                self._update()
-        except Exception as exc:  # noqa: BLE001 - keep the last plots, say what happened
-            log.warning("%s kept its last plots: %s: %s", type(self).__name__, type(exc).__name__, exc)
+        update_or_keep(f"{type(self).__name__} kept its last plots", self._refresh)
+
+    def _refresh(self):
+        mode = self.state.design.mode
+        if mode != self._mode:
+            self._mode = mode
+            self._set_axes(_axes(mode))
+        self._update()
 
     def _set_axes(self, axes):
         raise NotImplementedError
@@ -465,19 +474,18 @@ class TeachingView(PlotView):
         self._frame()
 
     def _frame(self):
-        try:
-            with pn.io.hold():
-                x = np.geomspace(*self.state.amplitude_bounds, self.FRAMES)[self.player.value]
-                data = self.state.hysteresis_loop(amplitude=x)
-                xn = data["displacement"] / np.max(np.abs(data["displacement"]))
-                peak = np.max(np.abs(data["force"]))
-                self.loop.set("total", x=xn, y=data["force"] / peak)
-                for name in plots.BRANCH_COLORS:
-                    self.loop.set(name, x=xn, y=data[f"force_{name}"] / peak)
-                self.frame_label.object = (f'<span class="frame-point">Loop shape at <b>{x:.3g} '
-                                           f"{self.state.amplitude_unit}</b>, {self.state.frequency_hz:.3g} Hz</span>")
-        except Exception as exc:  # noqa: BLE001 - keep the last frame
-            log.warning("TeachingView kept its last frame: %s: %s", type(exc).__name__, exc)
+        update_or_keep("TeachingView kept its last frame", self._draw_frame)
+
+    def _draw_frame(self):
+        x = np.geomspace(*self.state.amplitude_bounds, self.FRAMES)[self.player.value]
+        data = self.state.hysteresis_loop(amplitude=x)
+        xn = data["displacement"] / np.max(np.abs(data["displacement"]))
+        peak = np.max(np.abs(data["force"]))
+        self.loop.set("total", x=xn, y=data["force"] / peak)
+        for name in plots.BRANCH_COLORS:
+            self.loop.set(name, x=xn, y=data[f"force_{name}"] / peak)
+        self.frame_label.object = (f'<span class="frame-point">Loop shape at <b>{x:.3g} '
+                                   f"{self.state.amplitude_unit}</b>, {self.state.frequency_hz:.3g} Hz</span>")
 
     def __panel__(self):
         return pn.Column(

@@ -160,6 +160,11 @@ def _check_slices(slices) -> int | str:
     return int(slices)
 
 
+def _effective_slices(design: Design, slices: int | str) -> int | str:
+    """The continuum where one slice is asked of a design with the nonuniform_strain effect."""
+    return "continuum" if slices == 1 and "nonuniform_strain" in design.effect_parameters else slices
+
+
 def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | str = 1,
                      route: Route = "analytic") -> np.ndarray:
     """Complex stiffness at paired points (frequency_hz[i], amplitude[i]), broadcast together:
@@ -176,8 +181,7 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
     effects = design.effect_parameters
     modulus = modulus_function(design, route)
     c = strain_factor(geo, mode)
-    if "nonuniform_strain" in effects and slices == 1:
-        slices = "continuum"
+    slices = _effective_slices(design, slices)
     if "wave_effects" in effects:
         if slices != 1:
             raise ValueError(
@@ -205,8 +209,7 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
 def _stiffness_cached(design: Design, freq: tuple, amp: tuple, slices, route) -> StiffnessResult:
     f = np.array(freq)
     x = np.array(amp)
-    if "nonuniform_strain" in design.effect_parameters and slices == 1:
-        slices = "continuum"
+    slices = _effective_slices(design, slices)
     k = stiffness_points(design, f[None, :], x[:, None], slices=slices, route=route)
     return StiffnessResult(design, _readonly(f), _readonly(x), _readonly(np.array(k)), slices, route)
 

@@ -7,7 +7,6 @@ cannot converge exits with status 1 and one line; no traceback is ever printed.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 from contextlib import contextmanager
@@ -248,7 +247,7 @@ def _cmd_fit(args) -> None:
     data = read_stiffness(args.measured)
     loop_data = read_loop(args.loop) if args.loop else None
     result = fit_global(design, data, loop_data)
-    _write_text(json.dumps(result.to_dict(), indent=2) + "\n", args.output)
+    _write_text(result.to_json(), args.output)
 
 
 def _cmd_diagnose(args) -> None:
@@ -263,7 +262,7 @@ def _cmd_diagnose(args) -> None:
     design = read_design(args.design)
     data = read_stiffness(args.measured)
     result = diagnose(design, data, baseline=baseline)
-    report = json.dumps(result.report(), indent=2, allow_nan=False) + "\n"
+    report = result.to_json()
     if args.predictions:
         _write_csv(result.predictions(), args.predictions)
     _write_text(report, args.report)

@@ -29,6 +29,12 @@ class DataError(ValueError):
     """A measured-data file breaks a rule; the message names the line and the reason."""
 
 
+def loss_factor(k) -> np.ndarray:
+    """η = Im K / Re K of complex stiffness (MODEL.md)."""
+    k = np.asarray(k)
+    return k.imag / k.real
+
+
 class ComplexStiffness:
     """Magnitude and loss factor of a ``stiffness`` attribute holding complex K."""
 
@@ -40,8 +46,7 @@ class ComplexStiffness:
 
     @property
     def loss_factor(self) -> np.ndarray:
-        """η = Im K / Re K (MODEL.md)."""
-        return self.stiffness.imag / self.stiffness.real
+        return loss_factor(self.stiffness)
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,16 +64,22 @@ class MeasuredStiffness(ComplexStiffness):
         mask = np.asarray(mask)
         return MeasuredStiffness(self.frequency_hz[mask], self.amplitude[mask], self.stiffness[mask])
 
+    def amplitudes(self) -> np.ndarray:
+        """The distinct amplitudes, the most frequent first (ties in increasing order)."""
+        values, counts = np.unique(self.amplitude, return_counts=True)
+        return values[np.argsort(-counts, kind="stable")]
+
     def to_csv(self, path: str | Path | None = None, polar: bool = True) -> str:
         cols = {"frequency_hz": self.frequency_hz, "amplitude": self.amplitude}
         if polar:
             cols.update(magnitude=self.magnitude, loss_factor=self.loss_factor)
         else:
             cols.update(stiffness_real=self.stiffness.real, stiffness_imag=self.stiffness.imag)
-        text = pd.DataFrame(cols).to_csv(index=False, float_format="%.10g", lineterminator="\n")
-        if path is not None:
-            Path(path).write_text(text, encoding="utf-8")
-        return text
+        return _written(csv_text(cols, FILE_NUMBER_FORMAT), path)
+
+
+# numbers in the measured-data files this package writes (examples, demos, synthetic data)
+FILE_NUMBER_FORMAT = "{:.10g}"
 
 
 def csv_text(columns: dict[str, np.ndarray], number_format: str = "{:.12g}") -> str:
@@ -81,6 +92,12 @@ def csv_text(columns: dict[str, np.ndarray], number_format: str = "{:.12g}") -> 
     return buf.getvalue()
 
 
+def _written(text: str, path: str | Path | None) -> str:
+    if path is not None:
+        Path(path).write_text(text, encoding="utf-8")
+    return text
+
+
 @dataclass(frozen=True, eq=False)
 class MeasuredLoop:
     """A measured steady harmonic test: displacement (m or rad) and force (N or N·m) in time."""
@@ -88,6 +105,11 @@ class MeasuredLoop:
     time_s: np.ndarray
     displacement: np.ndarray
     force: np.ndarray
+
+    def to_csv(self, path: str | Path | None = None) -> str:
+        """The loop file of FORMATS.md: time_s, displacement, force."""
+        cols = {"time_s": self.time_s, "displacement": self.displacement, "force": self.force}
+        return _written(csv_text(cols, FILE_NUMBER_FORMAT), path)
 
     def harmonic(self):
         """Frequency (Hz), peak amplitude and the phase θ(t) of the drive x ≈ x̂ sin θ, from a

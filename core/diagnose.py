@@ -31,6 +31,7 @@ A branch the baseline lacks is held at a value with no effect on any stiffness (
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -38,10 +39,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .bushing import stiffness_points
-from .data import MeasuredStiffness
+from .data import MeasuredStiffness, loss_factor
 from .design import Design
 from .effects import EFFECTS
-from .fit import FitResult, fit_global, gap, parameter, parameter_values, with_values
+from .fit import (
+    FitResult,
+    fit_global,
+    gap,
+    parameter,
+    parameter_values,
+    relative_residual,
+    with_values,
+)
 from .material import ConvergenceError
 
 BRANCHES = ("elastic", "fractional", "friction")
@@ -56,9 +65,9 @@ BIC_THRESHOLD = 10.0
 EXPLAINED_FRACTION = 0.8  # an effect is named when it explains 80 % of the misfit above the noise
 NOISE_TOLERANCE = 0.15  # … or leaves no more than 15 % of the noise's variance (its estimate's spread)
 NOISE_RATIO = 1.3  # a mean squared misfit above 1.3 × the noise's is "above the noise"
-PAIR_POOL = 4
+PAIR_POOL = 4  # pairs are sought among the four best single candidates
 MAX_FOLDS, HELD_OUT_BANDS = 12, 5  # held-out folds: single values up to 12, else 5 bands
-PRECISION = 1e-6  # relative misfits below this are numerical, not measured  # pairs are sought among the four best single candidates
+PRECISION = 1e-6  # relative misfits below this are numerical, not measured
 GRID_1D, GRID_2D = 16, 9  # starting-value grids of a candidate's parameters
 BASELINE_STARTS = 8
 
@@ -122,11 +131,6 @@ def candidates(model: Model) -> list[str]:
 # --------------------------------------------------------------------------------------------
 # Misfit statistics
 # --------------------------------------------------------------------------------------------
-
-
-def relative_residual(model_k: np.ndarray, data: MeasuredStiffness) -> np.ndarray:
-    """(K_model − K_data) / |K_data|: complex, one per point (the gap's terms)."""
-    return (model_k - data.stiffness) / np.abs(data.stiffness)
 
 
 def bic(residual: np.ndarray, n_parameters: int) -> float:
@@ -283,7 +287,7 @@ def describe(data: MeasuredStiffness, model_k: np.ndarray, mode: str, noise_sd: 
     """
     quantities = (
         ("|K|", np.abs(model_k) / data.magnitude - 1.0, ("too stiff", "too soft"), noise_sd),
-        ("loss factor", model_k.imag / model_k.real - data.loss_factor, ("too high", "too low"),
+        ("loss factor", loss_factor(model_k) - data.loss_factor, ("too high", "too low"),
          noise_sd * float(np.sqrt(np.mean(1.0 + data.loss_factor**2)))),
     )
     axes = (_bins(data.frequency_hz), _bins(data.amplitude))
@@ -329,7 +333,7 @@ class Fitted:
     model: Model
     fit: FitResult
     stiffness: np.ndarray  # the model's complex K at the data points
-    residual: np.ndarray  # relative_residual(stiffness, data)
+    residual: np.ndarray  # relative_residual(stiffness, data.stiffness)
     bic: float
 
     @property
@@ -409,6 +413,10 @@ class Diagnosis:
             out["held_out"] = self.held_out
         return out
 
+    def to_json(self) -> str:
+        """The report as JSON text (strict: no NaN)."""
+        return json.dumps(self.report(), indent=2, allow_nan=False) + "\n"
+
     def predictions(self) -> dict[str, np.ndarray]:
         """Per data row: the baseline's and the final model's |K| and loss factor."""
         kb, kf = self.baseline.stiffness, self.final.stiffness
@@ -416,16 +424,16 @@ class Diagnosis:
             "frequency_hz": self.data.frequency_hz,
             "amplitude": self.data.amplitude,
             "baseline_magnitude": np.abs(kb),
-            "baseline_loss_factor": kb.imag / kb.real,
+            "baseline_loss_factor": loss_factor(kb),
             "final_magnitude": np.abs(kf),
-            "final_loss_factor": kf.imag / kf.real,
+            "final_loss_factor": loss_factor(kf),
         }
 
 
 def _fit(model: Model, data: MeasuredStiffness, **kwargs) -> Fitted:
     result = fit_global(model.design, data, free=model.free, **kwargs)
     k = stiffness_points(result.design, data.frequency_hz, data.amplitude)
-    residual = relative_residual(k, data)
+    residual = relative_residual(k, data.stiffness)
     return Fitted(Model(result.design, model.branches), result, k, residual, bic(residual, len(model.free)))
 
 
@@ -454,7 +462,7 @@ def _candidate_starts(current: Fitted, effect_id: str, data: MeasuredStiffness, 
             k = stiffness_points(trial.design, data.frequency_hz, data.amplitude)
         except (ValueError, ArithmeticError, ConvergenceError):
             continue
-        r = relative_residual(k, data)
+        r = relative_residual(k, data.stiffness)
         if np.all(np.isfinite(r)):
             scored.append((float(np.sum(np.abs(r) ** 2)), values))
     scored.sort(key=lambda s: s[0])

@@ -20,6 +20,7 @@ of the fitted (log) parameters, which the monotone transforms leave unchanged to
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -80,9 +81,14 @@ def with_values(design: Design, values: dict[str, float]) -> Design:
     return design.replace(**changes)
 
 
+def relative_residual(model: np.ndarray, data: np.ndarray) -> np.ndarray:
+    """(K_model − K_data) / |K_data|: complex, one per point (the gap's terms, what fits minimise)."""
+    return (model - data) / np.abs(data)
+
+
 def gap(model: np.ndarray, data: np.ndarray) -> float:
     """FORMATS.md's gap: sqrt(mean(|K_model − K_data|² / |K_data|²))."""
-    return float(np.sqrt(np.mean(np.abs(model - data) ** 2 / np.abs(data) ** 2)))
+    return float(np.sqrt(np.mean(np.abs(relative_residual(model, data)) ** 2)))
 
 
 @dataclass(frozen=True)
@@ -116,6 +122,10 @@ class FitResult:
 
     def to_dict(self) -> dict:
         return {**self.design.to_dict(), "fit": self.report()}
+
+    def to_json(self) -> str:
+        """The fitted design file (FORMATS.md): the design and its ``fit`` object."""
+        return json.dumps(self.to_dict(), indent=2) + "\n"
 
 
 class _Problem:
@@ -154,7 +164,7 @@ class _Problem:
         parts = []
         if self.data is not None:
             k = stiffness_points(design, self.data.frequency_hz, self.data.amplitude)
-            r = (k - self.data.stiffness) / np.abs(self.data.stiffness)
+            r = relative_residual(k, self.data.stiffness)
             parts += [r.real, r.imag]
         if self.loop is not None:
             f = sum(loop_force(design, self.loop_f, self.loop_amp, self.loop_phase))

@@ -38,12 +38,6 @@ def synthetic_loop(design: Design, frequency_hz: float, amplitude: float, *, per
     return MeasuredLoop(t, amplitude * np.sin(theta), force)
 
 
-def loop_csv(loop: MeasuredLoop) -> str:
-    rows = ["time_s,displacement,force"]
-    rows += [f"{a:.10g},{b:.10g},{c:.10g}" for a, b, c in zip(loop.time_s, loop.displacement, loop.force)]
-    return "\n".join(rows) + "\n"
-
-
 # The example sets of examples/ (and of the explorer's demo button), with their stated seeds.
 PAPER_B_AMPLITUDES = (0.013e-3, 0.04e-3, 0.1e-3, 0.17e-3, 0.35e-3)
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from core import PAPER_B, TABLE_1, write_design
-from core.synthetic import PAPER_B_AMPLITUDES, loop_csv, paper_b_example, synthetic_stiffness
+from core.synthetic import PAPER_B_AMPLITUDES, paper_b_example, synthetic_stiffness
 
 HERE = Path(__file__).resolve().parent
 
@@ -23,7 +23,7 @@ def main():
     # Paper B bushing (axial): the thesis' amplitudes, 1-100 Hz, 150 points; the 0.1 Hz, 1 mm loop
     data, loop = paper_b_example(PAPER_B)
     data.to_csv(HERE / "paper_b_stiffness.csv")
-    (HERE / "paper_b_loop.csv").write_text(loop_csv(loop))
+    loop.to_csv(HERE / "paper_b_loop.csv")
     synthetic_stiffness(PAPER_B, np.linspace(1, 100, 100), [0.1e-3], seed=12347).to_csv(
         HERE / "paper_b_sweep_0.1mm.csv")
     # Table 1 bushing (torsion): 10-100 Hz at five angles, as real and imaginary parts

@@ -265,10 +265,10 @@ def test_other_tabs_are_built_when_opened_and_catch_up_when_shown(app):
 
 
 def example_files():
-    from core.synthetic import loop_csv, paper_b_example
+    from core.synthetic import paper_b_example
 
     data, loop = paper_b_example(PAPER_B)
-    return data.to_csv().encode(), loop_csv(loop).encode()
+    return data.to_csv().encode(), loop.to_csv().encode()
 
 
 def test_measured_points_appear_over_the_model(app):
@@ -279,8 +279,15 @@ def test_measured_points_appear_over_the_model(app):
     x, y = data(figure(app, "magnitude", "frequency"), "measured")
     assert len(x) == 150 and np.all(y > 0)
     points = app.state.measured_points()
+    assert_allclose(y, points["magnitude"])
+    assert_allclose(x, points["frequency_hz"])
     k_model = stiffness_points(app.state.design, points["frequency_hz"], points["amplitude"] * 1e-3)
-    assert_allclose(points["magnitude_residual_pct"], 100 * (np.abs(k_model) / app.state.measured.magnitude - 1))
+    residuals = app.state.measured_residuals()
+    assert_allclose(residuals["magnitude_residual_pct"], 100 * (np.abs(k_model) / app.state.measured.magnitude - 1))
+    app.tabs.active = 3  # the residual plots hold the same numbers
+    assert_allclose(data(app.measured.figures[("magnitude", "frequency")], "points")[1],
+                    residuals["magnitude_residual_pct"])
+    app.tabs.active = 0
     assert app.state.load_measured_loop(loop_bytes, "l.csv")
     assert app.state.frequency_hz == pytest.approx(0.1) and app.state.amplitude == pytest.approx(1.0)
     lx, _ = data(app.plots.loop, "measured")
@@ -314,7 +321,7 @@ def test_fit_in_the_app_and_take_it_into_the_explorer(app):
     app.state.use_fit()
     assert app.state.design.material.shear_modulus == pytest.approx(r.design.material.shear_modulus, rel=1e-9)
     assert (app.state.frequency_hz, app.state.amplitude) == (f_op, x_op)
-    assert app.state.measured_points()["gap"] == pytest.approx(r.gap, rel=1e-6)
+    assert app.state.measured_residuals()["gap"] == pytest.approx(r.gap, rel=1e-6)
     fitted = loads_design(app.measured._fitted_json().getvalue())
     assert fitted.material == r.design.material
 
@@ -337,6 +344,7 @@ def test_the_thesis_two_step_fit_in_the_app(app):
     app.state.run_fit()
     r = app.state.fit_result
     assert r.method == "two-step" and r.points == 30  # the 0.1 mm sweep
+    assert app.state.data_message == ""  # the earlier refusal is no longer shown
     assert r.design.material.shear_modulus == pytest.approx(2.42e6, rel=0.03)
     assert "two-step" in app.measured.results.object
 

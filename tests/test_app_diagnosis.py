@@ -59,6 +59,11 @@ def test_a_diagnosis_in_the_tab_holds_the_core_numbers(app):
     xs, ys = fig.sources["final"].data["xs"], fig.sources["final"].data["ys"]
     k = stiffness_points(r.final.design, xs[2], 0.1e-3)
     np.testing.assert_allclose(ys[2], np.abs(k) / 1e6, rtol=1e-12)
+    # each curve plot's ranges take in the data and both models' curves
+    for quantity, f in view.curve_figs.items():
+        y = np.concatenate([*f.sources["baseline"].data["ys"], *f.sources["final"].data["ys"],
+                            f.sources["data"].data["y"]])
+        assert f.ranges["y"].range.start < y.min() and y.max() < f.ranges["y"].range.end, quantity
     # the misfit map: model − data in % of |K|
     m = view.maps[("final", "magnitude")].sources["misfit"].data
     d = state.data

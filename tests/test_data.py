@@ -58,6 +58,22 @@ def test_good_files_in_both_forms_agree():
     assert len(polar) == 2
 
 
+def test_amplitudes_most_frequent_first():
+    d = MeasuredStiffness(np.arange(1.0, 7.0), np.array([3e-4, 1e-4, 2e-4, 1e-4, 3e-4, 1e-4]), np.ones(6, complex))
+    assert list(d.amplitudes()) == [1e-4, 3e-4, 2e-4]  # 3 times, twice (ties: smaller first), once
+
+
+def test_a_written_loop_reads_back_as_it_was():
+    from core.synthetic import synthetic_loop
+
+    loop = synthetic_loop(PAPER_B, 0.1, 1e-3, seed=5)
+    text = loop.to_csv()
+    assert text.splitlines()[0] == "time_s,displacement,force"
+    back = parse_loop(text)
+    for name in ("time_s", "displacement", "force"):
+        assert_allclose(getattr(back, name), getattr(loop, name), rtol=1e-9, atol=0)
+
+
 def test_too_large_and_not_text(tmp_path):
     big = tmp_path / "big.csv"
     big.write_bytes(b"x" * (MAX_BYTES + 1))
