@@ -22,7 +22,7 @@ from typing import Literal
 import numpy as np
 
 from . import material as mat
-from .data import ComplexStiffness
+from .data import ComplexStiffness, loss_factor
 from .design import Design, Geometry
 from .effects import extended_modulus, inertia_correction, wave_stiffness
 from .material import REFERENCE_FREQUENCY_HZ
@@ -108,7 +108,7 @@ class StiffnessResult(ComplexStiffness):
             "stiffness_real": k.real,
             "stiffness_imag": k.imag,
             "magnitude": np.abs(k),
-            "loss_factor": k.imag / k.real,
+            "loss_factor": loss_factor(k),
         }
 
 
