@@ -9,19 +9,15 @@ import logging
 
 import numpy as np
 import panel as pn
-from bokeh.models import FactorRange, LinearColorMapper, Span
-from bokeh.palettes import RdBu11
-from bokeh.plotting import figure
 
 from core.diagnose import BIC_THRESHOLD
 from core.effects import EFFECTS
 from core.material import ConvergenceError
 
-from . import plots
+from . import curves, plots
 from .diagnosis_state import DiagnosisState
-from .figures import Axis, Figure
-from .state import AMPLITUDE_DISPLAY, STIFFNESS_DISPLAY
-from .views import update_or_keep
+from .live import LivePlot, update_or_keep
+from .units import amplitude_unit
 
 log = logging.getLogger("bushing.app")
 
@@ -49,7 +45,6 @@ class DiagnosisView(pn.viewable.Viewer):
     def __init__(self, state: DiagnosisState, **params):
         super().__init__(**params)
         self.state = state
-        explorer = state.explorer
         self.file = pn.widgets.FileInput(accept=".csv,text/csv", sizing_mode="stretch_width",
                                          description="Measured dynamic stiffness: frequency_hz, amplitude, "
                                          "magnitude, loss_factor (or stiffness_real, stiffness_imag), SI.")
@@ -83,20 +78,18 @@ class DiagnosisView(pn.viewable.Viewer):
         self.download_predictions = pn.widgets.FileDownload(
             callback=lambda: io.StringIO(state.predictions_csv()), filename="bushing-predictions.csv",
             label="Predictions (CSV)", disabled=True)
-        self._build_figures(explorer.design.mode)
+        self.gap = self.curve_plots = self.maps = None
+        self._plot_holders = {name: pn.Column(sizing_mode="stretch_width") for name in ("gap", "curves", "maps")}
         self._results = pn.Column(
             "### 3. What the diagnosis found",
             self.report,
-            pn.Row(pn.pane.Bokeh(self.gap_fig, sizing_mode="stretch_width"), sizing_mode="stretch_width"),
+            self._plot_holders["gap"],
             "**Data (points) against the baseline (dashed) and the final model (solid)**",
             self.curve_key,
-            pn.Row(*(pn.pane.Bokeh(self.curve_figs[q].fig, sizing_mode="stretch_width") for q in ("magnitude", "loss")),
-                   sizing_mode="stretch_width"),
+            self._plot_holders["curves"],
             "**Misfit over the (frequency, amplitude) plane**, model − data: the baseline above, the final "
             "model below, on the same colour scale",
-            pn.GridBox(*(pn.pane.Bokeh(self.maps[(w, q)].fig, sizing_mode="stretch_width")
-                         for w in ("baseline", "final") for q in ("magnitude", "loss")),
-                       ncols=2, sizing_mode="stretch_width"),
+            self._plot_holders["maps"],
             "### 4. Take it further",
             pn.Row(self.use, self.reveal, self.download_report, self.download_predictions),
             self.truth,
@@ -104,60 +97,7 @@ class DiagnosisView(pn.viewable.Viewer):
         )
         state.param.watch(self._refresh, ["data", "source", "message", "result", "running", "mystery", "revealed"])
         state.param.watch(self._on_progress, ["progress", "progress_message"])
-        explorer.param.watch(self._on_mode, "design")
         self._refresh()
-
-    # ---- figures -------------------------------------------------------------------------------
-
-    def _build_figures(self, mode: str):
-        self._mode = mode
-        self.gap_fig = figure(title="Gap (relative RMS misfit of complex stiffness) after each step",
-                              x_range=FactorRange(factors=["baseline"]), height=230, sizing_mode="stretch_width",
-                              tools="save", toolbar_location="right")
-        self.gap_fig.toolbar.logo = None
-        self.gap_fig.title.text_font_size = "13px"
-        self.gap_fig.yaxis.axis_label = "gap"
-        self.gap_fig.y_range.start = 0
-        self.gap_source = self.gap_fig.vbar(x="stage", top="gap", width=0.6, color="#3182bd",
-                                            source={"stage": [], "gap": []}).data_source
-        self.noise_line = Span(location=0, dimension="width", line_color="#d62728", line_dash="dashed",
-                               line_width=2, visible=False)
-        self.gap_fig.add_layout(self.noise_line)
-        freq = Axis("frequency_hz", "Frequency", "Hz")
-        amp_unit = AMPLITUDE_DISPLAY[mode][0]
-        k_unit = STIFFNESS_DISPLAY[mode][0]
-        self.curve_figs = {}
-        for quantity, y in (("magnitude", Axis("magnitude", "|K|", k_unit)), ("loss", Axis("loss_factor", "Loss factor"))):
-            fig = Figure(f"{y.label}: data, baseline and final model", freq, y, legend=None, height=280,
-                         png=f"bushing-diagnosis-{quantity}")
-            fig.lines("baseline", [], plots.SWEEP_PALETTES["amplitude"], line_dash="dashed", line_width=1.5)
-            fig.lines("final", [], plots.SWEEP_PALETTES["amplitude"], line_width=2)
-            fig.coloured_points("data", size=6, alpha=0.8)
-            self.curve_figs[quantity] = fig
-        self.mappers = {"magnitude": LinearColorMapper(palette=RdBu11[::-1], low=-1, high=1),
-                        "loss": LinearColorMapper(palette=RdBu11[::-1], low=-0.01, high=0.01)}
-        self.maps = {}
-        for which in ("baseline", "final"):
-            for quantity, title in (("magnitude", "|K| misfit (%)"), ("loss", "loss-factor misfit")):
-                fig = Figure(f"{which.capitalize()}: {title}", freq, Axis("amplitude", "Amplitude", amp_unit),
-                             y_log=True, legend=None, height=260, png=f"bushing-misfit-{which}-{quantity}",
-                             hover=False)
-                fig.mapped_points("misfit", self.mappers[quantity], title, size=11, marker="square")
-                self.maps[(which, quantity)] = fig
-
-    def _set_mode(self, mode: str):
-        """Axis units follow the mode (of the explorer's design, or of the diagnosed one)."""
-        if mode == self._mode:
-            return
-        self._mode = mode
-        for fig in self.maps.values():
-            fig.set_axes(fig.x, Axis("amplitude", "Amplitude", AMPLITUDE_DISPLAY[mode][0]))
-        magnitude = self.curve_figs["magnitude"]
-        magnitude.set_axes(magnitude.x, Axis("magnitude", "|K|", STIFFNESS_DISPLAY[mode][0]))
-
-    def _on_mode(self, event):
-        if self.state.result is None:
-            self._set_mode(event.new.mode)
 
     # ---- events --------------------------------------------------------------------------------
 
@@ -224,7 +164,6 @@ class DiagnosisView(pn.viewable.Viewer):
         if r is None:
             self.report.object = ""
             return
-        self._set_mode(r.final.design.mode)
         self.report.object = self._report_text(r)
         self._draw(r)
 
@@ -260,33 +199,37 @@ class DiagnosisView(pn.viewable.Viewer):
         return "\n\n".join(lines)
 
     def _draw(self, r):
-        stages = self.state.gap_stages()
-        self.gap_fig.x_range.factors = stages["stage"]
-        self.gap_source.data = {"stage": stages["stage"], "gap": list(stages["gap"])}
-        if stages["noise"] is not None:
-            self.noise_line.location = float(stages["noise"])
-            self.noise_line.visible = True
-        curves = self.state.curves()["groups"]
+        mode = r.final.design.mode
+        dims = plots.dimensions(mode)
+        stages = curves.gap_stages(r)
+        dims["gap"].range = (0.0, 1.1 * max(float(np.max(stages["gap"])), stages["noise"] or 0.0))
+        groups = curves.curve_groups(r)
         palette = plots.SWEEP_PALETTES["amplitude"]
-        colours = [palette[i % len(palette)] for i in range(len(curves))]
-        unit = AMPLITUDE_DISPLAY[r.final.design.mode][0]
+        unit = amplitude_unit(mode)
         self.curve_key.object = "Amplitudes: " + " ".join(
-            f'<span style="color:{c};font-weight:bold">■ {plots.sweep_label(g["amplitude"], unit)}</span>'
-            for g, c in zip(curves, colours))
-        for i, quantity in enumerate(("magnitude", "loss")):
-            fig = self.curve_figs[quantity]
-            for which in ("baseline", "final"):  # through the figure: its ranges take the curves in
-                fig.set_lines(which, None, [g[which][i] for g in curves], each_x=[g["frequency_hz"] for g in curves])
-            fig.set("data", x=np.concatenate([g["frequency_hz"] for g in curves]),
-                    y=np.concatenate([g["data"][i] for g in curves]),
-                    color=[c for g, c in zip(curves, colours) for _ in g["frequency_hz"]])
-        base = self.state.misfit("baseline")
-        final = self.state.misfit("final")
-        for quantity, column in (("magnitude", "magnitude_pct"), ("loss", "loss_factor")):
-            top = float(np.max(np.abs(base[column]))) or 1.0
-            self.mappers[quantity].update(low=-top, high=top)
-            for which, m in (("baseline", base), ("final", final)):
-                self.maps[(which, quantity)].set("misfit", x=m["frequency_hz"], y=m["amplitude"], value=m[column])
+            f'<span style="color:{palette[i % len(palette)]};font-weight:bold">■ {plots.sweep_label(g["amplitude"], unit)}</span>'
+            for i, g in enumerate(groups))
+        for i, quantity in enumerate(("magnitude", "loss_factor")):  # the data and both models in view
+            dims[quantity].range = curves.padded([v for g in groups for v in (g["data"][i], g["baseline"][i], g["final"][i])])
+        base, final = curves.misfit_points(r, "baseline"), curves.misfit_points(r, "final")
+        dims["amplitude"].range = curves.padded([final["amplitude"]], log=True)
+        maps = []
+        for which, m in (("baseline", base), ("final", final)):
+            for column, name in (("magnitude_pct", "|K| misfit (%)"), ("loss_factor", "loss-factor misfit")):
+                limit = float(np.max(np.abs(base[column]))) or 1.0  # one colour scale for before and after
+                maps.append(plots.misfit_map(m, column, f"{which.capitalize()}: {name}", dims, limit,
+                                             f"bushing-misfit-{which}-{plots.MISFIT_PNG[column]}"))
+        curve_overlays = plots.diagnosis_curves(groups, dims)
+        shown = {"gap": ([plots.gap_bars(stages, dims)], 1), "curves": (list(curve_overlays.values()), 2),
+                 "maps": (maps, 2)}
+        for name, (items, cols) in shown.items():
+            live = getattr(self, name if name != "curves" else "curve_plots")
+            if live is None:
+                live = LivePlot(items)
+                setattr(self, name if name != "curves" else "curve_plots", live)
+                self._plot_holders[name].objects = [live.grid(cols)]
+            else:
+                live.show(items)
 
     def __panel__(self):
         return pn.Column(

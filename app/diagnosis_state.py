@@ -6,12 +6,13 @@ from __future__ import annotations
 import numpy as np
 import param
 
-from core.data import MeasuredStiffness, csv_text, loss_factor, parse_stiffness
+from core.data import MeasuredStiffness, csv_text, parse_stiffness
 from core.diagnose import BRANCHES, Diagnosis, diagnose
 from core.effects import EFFECTS
 from core.synthetic import MYSTERIES, Mystery
 
-from .state import AMPLITUDE_DISPLAY, STIFFNESS_DISPLAY, ExplorerState, read_measured
+from . import curves
+from .state import ExplorerState, read_measured
 
 
 class DiagnosisState(param.Parameterized):
@@ -111,44 +112,16 @@ class DiagnosisState(param.Parameterized):
 
     def gap_stages(self) -> dict:
         """The gap after each stage: baseline, then each added effect."""
-        r = self.result
-        labels = ["baseline"] + [f"+ {s.effect}" for s in r.steps]
-        gaps = [r.baseline.gap] + [s.gap_after for s in r.steps]
-        return {"stage": labels, "gap": np.array(gaps), "noise": r.noise_gap}
+        return curves.gap_stages(self.result)
 
     def misfit(self, which: str) -> dict:
         """Model − data over the (frequency, amplitude) plane: |K| in %, loss factor."""
-        r = self.result
-        k = (r.baseline if which == "baseline" else r.final).stiffness
-        d = r.data
-        return {
-            "frequency_hz": d.frequency_hz,
-            "amplitude": d.amplitude / AMPLITUDE_DISPLAY[r.final.design.mode][1],
-            "magnitude_pct": 100 * (np.abs(k) / d.magnitude - 1),
-            "loss_factor": loss_factor(k) - d.loss_factor,
-        }
+        return curves.misfit_points(self.result, which)
 
     def curves(self) -> dict:
         """Data and both models against frequency, one group per measured amplitude (the most
         populated five), display units."""
-        r = self.result
-        d = r.data
-        chosen = np.sort(d.amplitudes()[:5])
-        groups = []
-        mode = r.final.design.mode
-        x_unit, k_unit = AMPLITUDE_DISPLAY[mode][1], STIFFNESS_DISPLAY[mode][1]
-        for amp in chosen:
-            sel = np.flatnonzero(d.amplitude == amp)
-            sel = sel[np.argsort(d.frequency_hz[sel])]
-            kb, kf, kd = r.baseline.stiffness[sel], r.final.stiffness[sel], d.stiffness[sel]
-            groups.append({
-                "amplitude": float(amp / x_unit),
-                "frequency_hz": d.frequency_hz[sel],
-                "data": (np.abs(kd) / k_unit, loss_factor(kd)),
-                "baseline": (np.abs(kb) / k_unit, loss_factor(kb)),
-                "final": (np.abs(kf) / k_unit, loss_factor(kf)),
-            })
-        return {"groups": groups}
+        return {"groups": curves.curve_groups(self.result)}
 
     # ---- downloads -----------------------------------------------------------------------------
 

@@ -4,49 +4,25 @@ from __future__ import annotations
 
 import logging
 import os
-import re
 import sys
 
 import panel as pn
 import param
-from bokeh.models import CustomJS
-from panel.io import resources as panel_resources
-from panel.models.markup import HTML as PanelHTML
 
+from . import patches  # noqa: F401 - Panel's page resources (see the module)
 from .diagnosis import DiagnosisView
 from .diagnosis_state import DiagnosisState
+from .explorer import CompareView, ExplorerPlots
+from .inputs import DesignInputs, status_banner
 from .measured import MeasuredView
+from .share import URL_NAMES, ExportView
+from .slices import SlicesView
 from .state import ExplorerState
-from .views import (
-    URL_NAMES,
-    CompareView,
-    DesignInputs,
-    ExplorerPlots,
-    ExportView,
-    PlotView,
-    SlicesView,
-    TeachingView,
-    status_banner,
-)
+from .teaching import TeachingView
+from .views import PlotView
 
 pn.extension(throttled=False)
 
-
-# Panel 1.9 sends Bokeh's MathJax bundle (1.8 MB, the largest script of the page) whenever the
-# page holds an HTML pane, in case one holds math (holoviz/panel#8424; holoviz/panel#8179 would
-# load it late instead). The explorer's texts hold none: the bundle is sent only to a page whose
-# texts have math delimiters. Measured here: about 0.1 s of each page load.
-MATH_DELIMITERS = re.compile(r"\$\$|\\\(|\\\[")
-
-
-def holds_math(roots) -> bool:
-    """Whether any Panel HTML model under ``roots`` has text with math delimiters."""
-    return any(isinstance(model, PanelHTML) and MATH_DELIMITERS.search(model.text or "")
-               for root in roots for model in root.references())
-
-
-if hasattr(panel_resources, "_panel_use_mathjax"):
-    panel_resources._panel_use_mathjax = holds_math
 
 TITLE = "Bushing Explorer"
 
@@ -69,73 +45,6 @@ axially and N·m/rad in torsion. Files and the command line use SI.
 
 URL_DELAY_MS = 300
 
-# Three BokehJS costs paid on every paint, measured in Chromium on this machine (Bokeh 3.9; each
-# method is looked up first, and nothing is patched if it is not there; a browser test checks
-# that all three are active and that what they change still behaves as Bokeh's own code):
-#  * a plot component's stylesheet text is rewritten on every paint, nearly always with the text
-#    it already has, and each rewrite makes Chromium recollect the page's styles (about a fifth
-#    of the page's work per update). A rewrite that changes nothing is skipped.
-#  * every visual property read asks the CSS cascade for a `--bk-*` variable (three reads per
-#    `doit`, per tick label). The answers are kept until the running script returns (a
-#    microtask clears them): one paint asks once per property, the next paint asks again. This
-#    is the caching of bokeh/bokeh#15205 (after Bokeh 3.9); see also bokeh/bokeh#15286.
-#  * a glyph renderer places its (empty) DOM element over its data's bounding box by rewriting
-#    a stylesheet of its own; new data, new text, and Chromium re-parses the sheet and
-#    invalidates the styles of its whole tree scope: about 15 ms of style work per update. The
-#    same box is set as the element's inline style, which Chromium applies to that element
-#    alone.
-BOKEHJS_PAINT_PATCHES = """
-// window[flag] says what happened: `done` if the method was found and wrapped, else "unpatched".
-const patch = (flag, done, module, cls, method, wrap) => {
-  if (window[flag] != null) return
-  const mod = Bokeh.require(module)
-  const proto = mod != null && mod[cls] != null ? mod[cls].prototype : null
-  if (proto != null && typeof proto[method] === "function") {
-    proto[method] = wrap(proto[method])
-    window[flag] = done
-  } else {
-    window[flag] = "unpatched"
-  }
-}
-patch("bushingStyleWrites", "skip-unchanged", "core/dom", "InlineStyleSheet", "_update", (update) =>
-  function (css) { if (this.el.textContent !== css) update.call(this, css) })
-patch("bushingCssReads", "cached-per-task", "core/visuals/visual", "VisualProperties", "_get_css_value", (read) =>
-  function (name) {
-    if (this._bushing_css == null) {
-      this._bushing_css = new Map()
-      queueMicrotask(() => { this._bushing_css = null })
-    }
-    let value = this._bushing_css.get(name)
-    if (value === undefined) {
-      value = read.call(this, name)
-      this._bushing_css.set(name, value)
-    }
-    return value
-  })
-patch("bushingGlyphPosition", "inline-style", "models/renderers/glyph_renderer", "GlyphRendererView", "update_position", (update) =>
-  function () {
-    if (this.panel != null || this.position == null) {
-      return update.call(this)
-    }
-    if (this._bushing_inline == null) {
-      this.position.replace("")  // once: what an earlier paint wrote there no longer applies
-      this._bushing_inline = true
-    }
-    const { bbox } = this
-    const style = this.el.style
-    if (bbox != null && bbox.is_valid) {
-      style.removeProperty("display")
-      style.position = "absolute"
-      style.left = `${bbox.left}px`
-      style.top = `${bbox.top}px`
-      style.width = `${bbox.width}px`
-      style.height = `${bbox.height}px`
-    } else {
-      style.display = "none"
-    }
-  })
-"""
-
 
 class ShareLink(param.Parameterized):
     """The design as the address bar shows it: the state's linked parameters, untouched by
@@ -149,6 +58,12 @@ class ShareLink(param.Parameterized):
 for _name in URL_NAMES:
     if _name != "mode":
         ShareLink.param.add_parameter(_name, param.Number(default=None, allow_None=True))
+
+
+def flat(view: pn.viewable.Viewer) -> list:
+    """The items of a view's column, to be placed straight into a tab's column: a HoloViews
+    grid nested two columns deep in a tab was laid out with no width (Panel 1.9)."""
+    return list(view.__panel__().objects)
 
 
 class App(pn.viewable.Viewer):
@@ -176,7 +91,7 @@ class App(pn.viewable.Viewer):
         self._built: dict[str, pn.viewable.Viewer] = {}
         self._holders = {name: pn.Column(sizing_mode="stretch_width") for _title, name, _build in self.LAZY_TABS}
         self.tabs = pn.Tabs(
-            ("Explorer", pn.Column(self.compare, self.plots, sizing_mode="stretch_width")),
+            ("Explorer", pn.Column(self.compare, *flat(self.plots), sizing_mode="stretch_width")),
             *((title, self._holders[name]) for title, name, _build in self.LAZY_TABS),
             ("About", pn.pane.Markdown(ABOUT, sizing_mode="stretch_width")),
             dynamic=True,
@@ -195,7 +110,7 @@ class App(pn.viewable.Viewer):
         if name not in self._built:
             build = next(b for _title, n, b in self.LAZY_TABS if n == name)
             self._built[name] = build(self)
-            self._holders[name].objects = [self._built[name]]
+            self._holders[name].objects = flat(self._built[name])
             self._on_tab()
         return self._built[name]
 
@@ -268,8 +183,6 @@ def create_app():
     """Factory for one session (served per connection, so sessions never share state)."""
     app = App()
     app.sync_url()
-    if pn.state.curdoc is not None:
-        pn.state.curdoc.js_on_event("document_ready", CustomJS(code=BOKEHJS_PAINT_PATCHES))
     return app.template()
 
 

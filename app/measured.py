@@ -9,15 +9,19 @@ import logging
 
 import numpy as np
 import panel as pn
+import param
 
 from core import PAPER_B
 from core.fit import PARAMETERS
 from core.synthetic import paper_b_example
 
 from . import plots
-from .figures import AutoRange, Axis, Figure
+from .curves import padded
+from .live import LivePlot
 from .state import ExplorerState
 from .views import PlotView
+
+RESIDUALS = (("magnitude", "frequency"), ("loss", "frequency"), ("magnitude", "amplitude"), ("loss", "amplitude"))
 
 log = logging.getLogger("bushing.app")
 
@@ -32,8 +36,6 @@ LABELS = {
 
 class MeasuredView(PlotView):
     """Upload, fit and residuals."""
-
-    WATCH = ("design", "measured", "measured_loop", "fit_result", "data_message", "fit_method")
 
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
@@ -66,17 +68,17 @@ class MeasuredView(PlotView):
         self.message = pn.pane.HTML("", sizing_mode="stretch_width")
         self.summary = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.results = pn.pane.Markdown("", sizing_mode="stretch_width")
-        axes = {"frequency": Axis("frequency_hz", "Frequency", "Hz"), "amplitude": Axis("amplitude", "Amplitude", "")}
-        shared_y = {"magnitude": AutoRange(), "loss": AutoRange()}
-        for which, x in axes.items():
-            for quantity, y in (("magnitude", Axis("residual", "|K| residual", "%")),
-                                ("loss", Axis("residual", "Loss-factor residual", ""))):
-                fig = Figure(f"{y.label}, model − measured, against {x.label.lower()}", x, y,
-                             x_log=which == "amplitude", y_range=shared_y[quantity], legend=None, height=240,
-                             png=f"bushing-residual-{quantity}-vs-{which}")
-                fig.points("points", size=6, color=plots.OPERATING_COLOR, alpha=0.7)
-                self.figures[(quantity, which)] = fig
-        self._start()
+        self.residuals: LivePlot | None = None
+        self._update()  # built outside a held document: held, the new panes are laid out wrong
+
+    @param.depends("state.design", "state.measured", "state.measured_loop", "state.fit_result",
+                   "state.data_message", "state.fit_method", watch=True)
+    def _on_state(self):
+        self.changed()
+
+    def frame(self, quantity: str, against: str):
+        """What a residual plot shows now (``quantity`` "magnitude" or "loss")."""
+        return self.residuals.current[RESIDUALS.index((quantity, against))]
 
     # uploads run in the session: a bad file only sets a message
 
@@ -105,11 +107,6 @@ class MeasuredView(PlotView):
         r = self.state.fit_result
         return io.StringIO(r.to_json() if r is not None else "")
 
-    def _set_axes(self, axes):
-        for (_quantity, which), fig in self.figures.items():
-            x = axes["frequency"] if which == "frequency" else axes["amplitude"]
-            fig.set_axes(x, fig.y)
-
     def _update(self):
         s = self.state
         self.message.object = (f'<div class="data-error" style="color:#b03a2e">⚠ {s.data_message}</div>'
@@ -126,12 +123,7 @@ class MeasuredView(PlotView):
             lines.append(f"**Loop**: {s.measured_loop.time_s.size} samples at {f:.3g} Hz, amplitude "
                          f"{s.display_amplitude(amp):.3g} {s.amplitude_unit}")
         self.summary.object = "\n\n".join(lines) or "_No measured data loaded._"
-        for (quantity, which), fig in self.figures.items():
-            if points is None:
-                fig.clear("points")
-                continue
-            y = residuals["magnitude_residual_pct" if quantity == "magnitude" else "loss_factor_residual"]
-            fig.set("points", x=points["frequency_hz" if which == "frequency" else "amplitude"], y=y)
+        self._draw(points, residuals)
         options = {f"{s.display_amplitude(a):.4g} {s.amplitude_unit}": a for a in s.measured_amplitudes()}
         if options != self.sweep.options:
             self.sweep.options = options
@@ -139,6 +131,20 @@ class MeasuredView(PlotView):
         r = s.fit_result
         self.use.disabled = self.download.disabled = r is None
         self.results.object = self._results_table(r) if r is not None else ""
+
+    def _draw(self, points, residuals):
+        mode = self.state.design.mode
+        if mode != getattr(self, "_mode", None):
+            self.dims, self._mode = plots.dimensions(mode), mode
+        if points is not None:  # plots of the same quantity share the axis: one range for both
+            self.dims["residual_magnitude"].range = padded([residuals["magnitude_residual_pct"]])
+            self.dims["residual_loss"].range = padded([residuals["loss_factor_residual"]])
+        overlays = plots.residual_overlays(points, residuals, self.dims)
+        items = [overlays[k] for k in RESIDUALS]
+        if self.residuals is None:
+            self.residuals = LivePlot(items)
+        else:
+            self.residuals.show(items)
 
     @staticmethod
     def _results_table(r):
@@ -161,7 +167,7 @@ class MeasuredView(PlotView):
         return pn.Column(
             pn.pane.Markdown(
                 "Load measured dynamic stiffness (and, if you have one, a quasi-static loop) as CSV "
-                "files in the formats of FORMATS.md (drop a file on a button or click it), or the "
+                "files (drop a file on a button or click it; the formats are in the About tab), or the "
                 "synthetic example. The points appear over the model in the Explorer tab; the "
                 "residuals are below. **Fit** identifies µ, m, α, σ_fmax and ε½ with standard "
                 "errors; then take the fitted design into the explorer or save it.",
@@ -176,9 +182,6 @@ class MeasuredView(PlotView):
             pn.Row(self.fit_button, self.use),
             self.download,
             self.results,
-            pn.Row(*(pn.pane.Bokeh(self.figures[(q, "frequency")].fig, sizing_mode="stretch_width", height=240)
-                     for q in ("magnitude", "loss")), sizing_mode="stretch_width"),
-            pn.Row(*(pn.pane.Bokeh(self.figures[(q, "amplitude")].fig, sizing_mode="stretch_width", height=240)
-                     for q in ("magnitude", "loss")), sizing_mode="stretch_width"),
+            self.residuals.grid(2),
             sizing_mode="stretch_width",
         )

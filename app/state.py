@@ -14,14 +14,7 @@ import numpy as np
 import param
 
 from core import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material
-from core.bushing import (
-    branch_stiffness,
-    loop,
-    material_model,
-    stiffness,
-    stiffness_points,
-    strain_factor,
-)
+from core.bushing import stiffness, stiffness_points, strain_factor
 from core.data import (
     DataError,
     MeasuredLoop,
@@ -32,7 +25,9 @@ from core.data import (
 )
 from core.design import as_dict
 from core.fit import FitResult, fit_global, fit_two_step, gap
-from core.material import ConvergenceError
+
+from . import curves, units
+from .units import FREQUENCY_BOUNDS
 
 # display parameter → (design key, factor from display unit to SI)
 GEOMETRY_FIELDS = {
@@ -56,13 +51,6 @@ ERROR_FIELD = {
 
 PRESETS = {"Paper B bushing (axial)": PAPER_B, "Table 1 bushing (torsion)": TABLE_1}
 
-# the Fletcher–Gent range: equivalent strain from 1e-3 to 1e2 times ε½
-FG_RANGE = (1e-3, 1e2)
-AMPLITUDE_DISPLAY = {"axial": ("mm", 1e-3), "torsion": ("rad", 1.0)}
-STIFFNESS_DISPLAY = {"axial": ("kN/mm", 1e6), "torsion": ("N·m/rad", 1.0)}
-FORCE_DISPLAY = {"axial": ("N", 1.0), "torsion": ("N·m", 1.0)}
-FREQUENCY_BOUNDS = (0.01, 10_000.0)
-SLICES = (1, 2, 3, "continuum")
 
 
 def _display_values(design: Design) -> dict:
@@ -161,8 +149,8 @@ class ExplorerState(param.Parameterized):
             return
         old, new = events[0].old, events[0].new
         geometry = self.design.geometry
-        eps = strain_factor(geometry, old) * self.amplitude * AMPLITUDE_DISPLAY[old][1]
-        x = eps / strain_factor(geometry, new) / AMPLITUDE_DISPLAY[new][1]
+        eps = strain_factor(geometry, old) * units.to_si_amplitude(self.amplitude, old)
+        x = units.display_amplitude(eps / strain_factor(geometry, new), new)
         self.amplitude = float(f"{x:.3g}")
 
     @param.depends(*DESIGN_FIELDS, "mode", "effects", "freq_min", "freq_max", watch=True, on_init=False)
@@ -298,15 +286,7 @@ class ExplorerState(param.Parameterized):
 
     def measured_points(self) -> dict | None:
         """Measured points in display units (as the data are: no model here)."""
-        d = self.measured
-        if d is None:
-            return None
-        return {
-            "frequency_hz": d.frequency_hz,
-            "amplitude": self.display_amplitude(d.amplitude),
-            "magnitude": self._stiffness_display(d.magnitude),
-            "loss_factor": d.loss_factor,
-        }
+        return curves.measured_points(self.measured, self.design.mode)
 
     def measured_residuals(self) -> dict | None:
         """The design at each measured point against the data: |K| in %, the loss factor, the gap."""
@@ -321,11 +301,7 @@ class ExplorerState(param.Parameterized):
         }
 
     def measured_loop_points(self) -> dict | None:
-        lp = self.measured_loop
-        if lp is None:
-            return None
-        return {"displacement": self.display_amplitude(lp.displacement - np.mean(lp.displacement)),
-                "force": lp.force - np.mean(lp.force)}
+        return curves.measured_loop_points(self.measured_loop, self.design.mode)
 
     def apply_url_values(self, values: dict):
         """Apply values from a shared link one by one, so one bad value spoils no other."""
@@ -342,128 +318,88 @@ class ExplorerState(param.Parameterized):
 
     @property
     def amplitude_unit(self) -> str:
-        return AMPLITUDE_DISPLAY[self.design.mode][0]
+        return units.amplitude_unit(self.design.mode)
 
     @property
     def stiffness_unit(self) -> str:
-        return STIFFNESS_DISPLAY[self.design.mode][0]
+        return units.stiffness_unit(self.design.mode)
 
     @staticmethod
     def fletcher_gent_amplitudes(design: Design, n: int = 5) -> np.ndarray:
         """Drive amplitudes (display units) spanning the Fletcher–Gent range, ε̂/ε½ = 1e-3 … 1e2,
         at n log-spaced points."""
-        c = strain_factor(design.geometry, design.mode)
-        scale = AMPLITUDE_DISPLAY[design.mode][1]
-        z = np.geomspace(*FG_RANGE, n)
-        return z * design.material.friction_strain_half / c / scale
+        return curves.fletcher_gent_amplitudes(design, n)
 
     @property
     def amplitude_bounds(self) -> tuple[float, float]:
-        x = self.fletcher_gent_amplitudes(self.design, 2)
-        return float(x[0]), float(x[1])
+        return curves.amplitude_bounds(self.design)
 
     def _si_amplitude(self, x):
-        return np.asarray(x, dtype=float) * AMPLITUDE_DISPLAY[self.design.mode][1]
+        return units.to_si_amplitude(x, self.design.mode)
 
     def display_amplitude(self, x_si):
         """An amplitude in SI (m or rad) in the display unit (mm or rad)."""
-        return np.asarray(x_si, dtype=float) / AMPLITUDE_DISPLAY[self.design.mode][1]
+        return units.display_amplitude(x_si, self.design.mode)
 
     def _stiffness_display(self, k):
-        return k / STIFFNESS_DISPLAY[self.design.mode][1]
+        return units.display_stiffness(k, self.design.mode)
+
+    @property
+    def freq_range(self) -> tuple[float, float]:
+        """The sweeps' frequency range, or 1–100 Hz while the input is not valid."""
+        if "freq_min" in self.errors or "freq_max" in self.errors:
+            return 1.0, 100.0
+        return float(self.freq_min), float(self.freq_max)
 
     def frequency_grid(self, n: int = 120) -> np.ndarray:
-        fmin, fmax = self.freq_min, self.freq_max
-        if "freq_min" in self.errors or "freq_max" in self.errors:
-            fmin, fmax = 1.0, 100.0
-        return np.linspace(fmin, fmax, n)
+        return np.linspace(*self.freq_range, n)
 
     def amplitude_grid(self, n: int = 120) -> np.ndarray:
-        return np.geomspace(*self.amplitude_bounds, n)
+        return curves.amplitude_grid(self.design, n)
 
     def sweep_amplitudes(self) -> np.ndarray:
         """The amplitudes of the frequency sweeps: decades of ε̂/ε½ from 0.01 to 10."""
-        return self.fletcher_gent_amplitudes(self.design, 6)[1:5]
+        return curves.sweep_amplitudes(self.design)
 
     def sweep_frequencies(self) -> np.ndarray:
-        f = self.frequency_grid(2)
-        return np.array([f[0], math.sqrt(f[0] * f[1]), f[1]])
+        return curves.sweep_frequencies(*self.freq_range)
 
     # ---- data for the plots (no drawing) ---------------------------------------------------
 
     def frequency_sweep(self, design: Design | None = None, amplitudes=None) -> dict:
         """|K| (display unit) and loss factor against frequency at several amplitudes."""
         design = design or self.design
-        amplitudes = self.sweep_amplitudes() if amplitudes is None else np.atleast_1d(amplitudes)
-        f = self.frequency_grid()
-        r = stiffness(design, f, self._si_amplitude(amplitudes))
-        return {"frequency_hz": f, "amplitude": amplitudes,
-                "magnitude": self._stiffness_display(r.magnitude), "loss_factor": r.loss_factor}
+        amplitudes = self.sweep_amplitudes() if amplitudes is None else amplitudes
+        return curves.frequency_sweep(design, self.frequency_grid(), amplitudes)
 
     def amplitude_sweep(self, design: Design | None = None, frequencies=None) -> dict:
         """|K| (display unit) and loss factor against amplitude at several frequencies."""
         design = design or self.design
-        frequencies = self.sweep_frequencies() if frequencies is None else np.atleast_1d(frequencies)
-        x = self.amplitude_grid()
-        r = stiffness(design, frequencies, self._si_amplitude(x))
-        return {"amplitude": x, "frequency_hz": frequencies,
-                "magnitude": self._stiffness_display(r.magnitude.T), "loss_factor": r.loss_factor.T}
+        frequencies = self.sweep_frequencies() if frequencies is None else frequencies
+        return curves.amplitude_sweep(design, self.amplitude_grid(), frequencies)
 
     def hysteresis_loop(self, design: Design | None = None, amplitude=None, points: int = 200):
         """One steady period at the operating point (or ``amplitude``), display units."""
-        design = material_model(design or self.design)  # stiffness-level effects have no branches
         x = self.amplitude if amplitude is None else amplitude
-        lp = loop(design, self.frequency_hz, float(self._si_amplitude(x)), points)
-        scale = 1.0 / AMPLITUDE_DISPLAY[design.mode][1]
-        close = np.r_[np.arange(points), 0]  # close the loop for drawing
-        return {
-            "displacement": lp.displacement[close] * scale,
-            "force": lp.force[close],
-            "force_elastic": lp.force_elastic[close],
-            "force_viscoelastic": lp.force_viscoelastic[close],
-            "force_friction": lp.force_friction[close],
-        }
+        return curves.hysteresis_loop(design or self.design, self.frequency_hz, x, points)
 
     def slice_comparison(self, n: int = 60) -> dict:
         """|K| and loss factor against amplitude at the operating frequency for 1, 2, 3 slices
         and the continuum, with the differences from the single modulus in %."""
-        x = self.amplitude_grid(n)
-        out = {"amplitude": x, "magnitude": {}, "loss_factor": {}, "magnitude_diff_pct": {},
-               "loss_factor_diff_pct": {}}
-        for s in SLICES:
-            try:
-                r = stiffness(material_model(self.design), self.frequency_hz, self._si_amplitude(x), slices=s)
-            except ConvergenceError:
-                continue  # said in the view; never an unconverged number
-            out["magnitude"][s] = self._stiffness_display(r.magnitude[:, 0])
-            out["loss_factor"][s] = r.loss_factor[:, 0]
-        base_m, base_e = out["magnitude"][1], out["loss_factor"][1]
-        for s in SLICES[1:]:
-            if s in out["magnitude"]:
-                out["magnitude_diff_pct"][s] = 100 * (out["magnitude"][s] / base_m - 1)
-                out["loss_factor_diff_pct"][s] = 100 * (out["loss_factor"][s] / base_e - 1)
-        return out
+        return curves.slice_comparison(self.design, self.frequency_hz, self.amplitude_grid(n))
 
     def branch_breakdown(self, n: int = 80) -> dict:
         """How the elastic, viscoelastic and friction branches make up K against amplitude at
-        the operating frequency: their shares of Re K and of the loss factor."""
-        x = self.amplitude_grid(n)
-        parts = {k: v[:, 0] for k, v in branch_stiffness(material_model(self.design), self.frequency_hz, self._si_amplitude(x)).items()}
-        total = sum(parts.values())
-        re = total.real
-        return {
-            "amplitude": x,
-            "magnitude": self._stiffness_display(np.abs(total)),
-            "loss_factor": total.imag / re,
-            "real": {k: self._stiffness_display(v.real) for k, v in parts.items()},
-            "loss": {k: v.imag / re for k, v in parts.items()},
-        }
+        the operating frequency."""
+        return curves.branch_breakdown(self.design, self.frequency_hz, self.amplitude_grid(n))
 
     def operating_point(self, design: Design | None = None) -> dict:
-        design = design or self.design
-        r = stiffness(design, self.frequency_hz, self._si_amplitude(self.amplitude))
-        return {"magnitude": float(self._stiffness_display(r.magnitude[0, 0])),
-                "loss_factor": float(r.loss_factor[0, 0])}
+        return curves.operating_point(design or self.design, self.frequency_hz, self.amplitude)
+
+    def explorer_data(self):
+        """Everything the explorer's five plots show (:func:`app.curves.explorer_data`)."""
+        return curves.explorer_data(self.design, self.frequency_hz, self.amplitude, freq_range=self.freq_range,
+                             reference=self.reference, measured=self.measured, measured_loop=self.measured_loop)
 
     def comparison(self) -> dict | None:
         """Current design against the pinned reference, in %, at the operating point and over

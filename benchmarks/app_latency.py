@@ -54,7 +54,7 @@ READY_JS = """(figures) => window.Bokeh && Bokeh.documents.length > 0 && Bokeh.d
 CHANGE_JS = """async ([title, value, quiet]) => {
   const doc = Bokeh.documents[0];
   const model = [...doc.all_models].find(m => m.title === title || m.label === title);
-  const PLOT = new Set(['ColumnDataSource', 'DataRange1d', 'Span', 'LegendItem', 'Legend', 'LinearAxis',
+  const PLOT = new Set(['ColumnDataSource', 'DataRange1d', 'Range1d', 'Span', 'LegendItem', 'Legend', 'LinearAxis',
                         'LogAxis', 'Title', 'Figure']);
   let lastPaint = null, lastChange = null;
   const cb = (ev) => {
@@ -223,6 +223,17 @@ async def measure(url, server_pid, n_changes, n_sessions, figures=5) -> dict:
         report(f"{n_sessions} sessions, back to back", [v for r in results for v in r], "saturation, for reference")
         await browser.close()
     return out
+
+
+def ratios(name: str, a: dict, b: dict):
+    """Print ``a`` / ``b`` for each figure of :func:`measure`."""
+    print(f"{name}:")
+    print(f"  first page load {a['load'] / b['load']:.2f}")
+    for which in ("one", "many"):
+        for label, f in (("median", statistics.median), ("p95", lambda v: pct(v, 95))):
+            print(f"  {which} session{'s' if which == 'many' else ''} {label} {f(a[which]) / f(b[which]):.2f}")
+    total = sum(a["cpu"].values()), sum(b["cpu"].values())
+    print(f"  CPU per change {total[0]:.0f} / {total[1]:.0f} ms = {total[0] / total[1]:.2f}")
 
 
 async def main(n_changes, n_sessions):

@@ -17,11 +17,10 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import statistics
 import sys
 
 import numpy as np
-from app_latency import free_port, measure, pct, start_server
+from app_latency import free_port, measure, ratios, start_server
 
 N_CURVES, N_POINTS = 5, 200
 
@@ -87,13 +86,7 @@ async def main(n_figures, n_changes, n_sessions, explorer):
     finally:
         server.terminate()
         server.wait(10)
-    print("explorer / floor:")
-    print(f"  first page load {app['load'] / floor['load']:.2f}")
-    for name in ("one", "many"):
-        for label, f in (("median", statistics.median), ("p95", lambda v: pct(v, 95))):
-            print(f"  {name} session{'s' if name == 'many' else ''} {label} {f(app[name]) / f(floor[name]):.2f}")
-    total = sum(app["cpu"].values()), sum(floor["cpu"].values())
-    print(f"  CPU per change {total[0]:.0f} / {total[1]:.0f} ms = {total[0] / total[1]:.2f}")
+    ratios("explorer / floor", app, floor)
 
 
 if __name__ == "__main__":

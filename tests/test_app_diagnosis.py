@@ -12,6 +12,7 @@ import pytest
 from app.main import App
 from core import PAPER_B, stiffness, stiffness_points
 from core.synthetic import MYSTERIES, synthetic_stiffness
+from tests.helpers import element, xy
 
 F = np.linspace(1, 100, 30)
 AMPS = (0.013e-3, 0.04e-3, 0.1e-3, 0.17e-3, 0.35e-3)
@@ -51,25 +52,28 @@ def test_a_diagnosis_in_the_tab_holds_the_core_numbers(app):
     assert "Step 1: add Apparent mass seen by the force sensor" in view.report.object
     assert "What is left is noise" in view.report.object
     # the gap bars: the baseline's and after each step; the noise line
-    assert list(view.gap_source.data["stage"]) == ["baseline", "+ inertia"]
-    np.testing.assert_allclose(view.gap_source.data["gap"], [r.baseline.gap, r.steps[0].gap_after])
-    assert view.noise_line.location == pytest.approx(r.noise_gap)
+    gap = view.gap.current[0]
+    bars = gap.get(0)
+    assert list(bars.dimension_values(0)) == ["baseline", "+ inertia"]
+    np.testing.assert_allclose(bars.dimension_values(1), [r.baseline.gap, r.steps[0].gap_after])
+    assert gap.get(1).data == pytest.approx(r.noise_gap)  # the noise line
     # the final model's curve at 0.1 mm is the core's stiffness of the final design, in kN/mm
-    fig = view.curve_figs["magnitude"]
-    xs, ys = fig.sources["final"].data["xs"], fig.sources["final"].data["ys"]
-    k = stiffness_points(r.final.design, xs[2], 0.1e-3)
-    np.testing.assert_allclose(ys[2], np.abs(k) / 1e6, rtol=1e-12)
-    # each curve plot's ranges take in the data and both models' curves
-    for quantity, f in view.curve_figs.items():
-        y = np.concatenate([*f.sources["baseline"].data["ys"], *f.sources["final"].data["ys"],
-                            f.sources["data"].data["y"]])
-        assert f.ranges["y"].range.start < y.min() and y.max() < f.ranges["y"].range.end, quantity
-    # the misfit map: model − data in % of |K|
-    m = view.maps[("final", "magnitude")].sources["misfit"].data
+    magnitude, loss = view.curve_plots.current
+    f, k = xy(magnitude, "0.1 mm final")
+    np.testing.assert_allclose(k, np.abs(stiffness_points(r.final.design, f, 0.1e-3)) / 1e6, rtol=1e-12)
+    # each curve plot's axis takes in the data and both models' curves
+    for ov in (magnitude, loss):
+        y = np.concatenate([el.dimension_values(1) for el in ov])
+        low, high = element(ov, "0.1 mm final").vdims[0].range
+        assert low < y.min() and y.max() < high
+    # the misfit map: model − data in % of |K|, the amplitude in mm
+    final_map = view.maps.current[2]
+    points = final_map.get(0)
     d = state.data
     expected = 100 * (np.abs(stiffness_points(r.final.design, d.frequency_hz, d.amplitude)) / d.magnitude - 1)
-    np.testing.assert_allclose(m["value"], expected, rtol=1e-9, atol=1e-12)
-    np.testing.assert_allclose(m["y"], d.amplitude * 1e3)
+    np.testing.assert_allclose(points.dimension_values(2), expected, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(points.dimension_values(1), d.amplitude * 1e3)
+    assert final_map.opts.get().kwargs["title"] == "Final: |K| misfit (%)"
     # the downloads are the command line's report and predictions
     assert json.loads(state.report_json()) == json.loads(json.dumps(r.report()))
     rows = list(csv.reader(io.StringIO(state.predictions_csv())))
@@ -87,11 +91,10 @@ def test_the_final_model_goes_into_the_explorer(app):
         state.result.final.design.effect_parameters["inertia"]["mass"])
     assert (app.state.frequency_hz, app.state.amplitude) == (f_op, x_op)
     # every explorer plot still draws: |K| with the inertia, the loop from the material model
-    x, y = (np.asarray(app.plots.figures[("magnitude", "frequency")].sources["operating"].data[c])
-            for c in ("x", "y"))
+    x, y = xy(app.plots.frame(("magnitude", "frequency")), "operating point")
     expected = stiffness(design, x, app.state.amplitude * 1e-3).magnitude[0] / 1e6
     np.testing.assert_allclose(y, expected, rtol=1e-9)
-    loop_x = app.plots.loop.sources["total"].data["x"]
+    loop_x, _ = xy(app.plots.frame("loop"), "total")
     assert len(loop_x) > 0
     assert "inertia act on the stiffness plots" in app.template().main[0].object
 

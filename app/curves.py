@@ -1,0 +1,258 @@
+"""What the plots draw, computed from a design: curves in display units (:mod:`app.units`).
+
+Pure functions of a design and the grids, no drawing and no session: the explorer's state and the
+public plotting API (:mod:`app.plots`) both use them. The core caches the stiffness maps, so
+asking twice for the same curve costs a look-up.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from core import Design
+from core.bushing import branch_stiffness, loop, material_model, stiffness, strain_factor
+from core.data import MeasuredLoop, MeasuredStiffness, loss_factor
+from core.material import ConvergenceError
+
+from . import units
+
+SLICES = (1, 2, 3, "continuum")
+# the frequency sweeps are drawn at these equivalent strains, as multiples of ε½
+SWEEP_STRAINS = (0.01, 0.1, 1.0, 10.0)
+
+
+def fletcher_gent_amplitudes(design: Design, n: int = 5, ratios=None) -> np.ndarray:
+    """Drive amplitudes (display units) at equivalent strains ``ratios`` × ε½, by default ``n``
+    log-spaced over the Fletcher–Gent range ε̂/ε½ = 1e-3 … 1e2."""
+    z = np.geomspace(*units.FG_RANGE, n) if ratios is None else np.asarray(ratios, dtype=float)
+    c = strain_factor(design.geometry, design.mode)
+    return units.display_amplitude(z * design.material.friction_strain_half / c, design.mode)
+
+
+def amplitude_bounds(design: Design) -> tuple[float, float]:
+    """The amplitude axis (display units): the Fletcher–Gent range."""
+    x = fletcher_gent_amplitudes(design, 2)
+    return float(x[0]), float(x[1])
+
+
+def amplitude_grid(design: Design, n: int = 120) -> np.ndarray:
+    return np.geomspace(*amplitude_bounds(design), n)
+
+
+def sweep_amplitudes(design: Design) -> np.ndarray:
+    """The amplitudes of the frequency sweeps: ε̂/ε½ = 0.01, 0.1, 1 and 10."""
+    return fletcher_gent_amplitudes(design, ratios=SWEEP_STRAINS)
+
+
+def sweep_frequencies(freq_min: float, freq_max: float) -> np.ndarray:
+    """The frequencies of the amplitude sweeps: both ends of the range and their geometric mean."""
+    return np.array([freq_min, math.sqrt(freq_min * freq_max), freq_max])
+
+
+def frequency_sweep(design: Design, frequencies, amplitudes) -> dict:
+    """|K| (display unit) and loss factor against frequency, one row per amplitude (display)."""
+    f = np.asarray(frequencies, dtype=float)
+    amplitudes = np.atleast_1d(np.asarray(amplitudes, dtype=float))
+    r = stiffness(design, f, units.to_si_amplitude(amplitudes, design.mode))
+    return {"frequency_hz": f, "amplitude": amplitudes,
+            "magnitude": units.display_stiffness(r.magnitude, design.mode), "loss_factor": r.loss_factor}
+
+
+def amplitude_sweep(design: Design, amplitudes, frequencies) -> dict:
+    """|K| (display unit) and loss factor against amplitude (display), one row per frequency."""
+    x = np.asarray(amplitudes, dtype=float)
+    frequencies = np.atleast_1d(np.asarray(frequencies, dtype=float))
+    r = stiffness(design, frequencies, units.to_si_amplitude(x, design.mode))
+    return {"amplitude": x, "frequency_hz": frequencies,
+            "magnitude": units.display_stiffness(r.magnitude.T, design.mode), "loss_factor": r.loss_factor.T}
+
+
+def hysteresis_loop(design: Design, frequency_hz: float, amplitude: float, points: int = 200) -> dict:
+    """One steady period at ``amplitude`` (display units), closed for drawing, branch by branch.
+    Stiffness-level effects have no branches: the loop is the material model's."""
+    design = material_model(design)
+    lp = loop(design, frequency_hz, float(units.to_si_amplitude(amplitude, design.mode)), points)
+    close = np.r_[np.arange(points), 0]
+    return {
+        "displacement": units.display_amplitude(lp.displacement[close], design.mode),
+        "force": lp.force[close],
+        "force_elastic": lp.force_elastic[close],
+        "force_viscoelastic": lp.force_viscoelastic[close],
+        "force_friction": lp.force_friction[close],
+    }
+
+
+def slice_comparison(design: Design, frequency_hz: float, amplitudes) -> dict:
+    """|K| and loss factor against amplitude at one frequency for 1, 2, 3 slices and the
+    continuum (Paper A), with the differences from the single modulus in %. A model whose
+    iteration does not converge is left out (never an unconverged number)."""
+    x = np.asarray(amplitudes, dtype=float)
+    out = {"amplitude": x, "magnitude": {}, "loss_factor": {}, "magnitude_diff_pct": {},
+           "loss_factor_diff_pct": {}}
+    model = material_model(design)
+    for s in SLICES:
+        try:
+            r = stiffness(model, frequency_hz, units.to_si_amplitude(x, design.mode), slices=s)
+        except ConvergenceError:
+            continue
+        out["magnitude"][s] = units.display_stiffness(r.magnitude[:, 0], design.mode)
+        out["loss_factor"][s] = r.loss_factor[:, 0]
+    base_m, base_e = out["magnitude"][1], out["loss_factor"][1]
+    for s in SLICES[1:]:
+        if s in out["magnitude"]:
+            out["magnitude_diff_pct"][s] = 100 * (out["magnitude"][s] / base_m - 1)
+            out["loss_factor_diff_pct"][s] = 100 * (out["loss_factor"][s] / base_e - 1)
+    return out
+
+
+def branch_breakdown(design: Design, frequency_hz: float, amplitudes) -> dict:
+    """How the elastic, viscoelastic and friction branches make up K against amplitude at one
+    frequency: their parts of Re K (display unit) and of the loss factor (Im K_branch / Re K)."""
+    x = np.asarray(amplitudes, dtype=float)
+    model = material_model(design)
+    parts = {k: v[:, 0] for k, v in branch_stiffness(model, frequency_hz, units.to_si_amplitude(x, design.mode)).items()}
+    total = sum(parts.values())
+    re = total.real
+    return {
+        "amplitude": x,
+        "magnitude": units.display_stiffness(np.abs(total), design.mode),
+        "loss_factor": loss_factor(total),
+        "real": {k: units.display_stiffness(v.real, design.mode) for k, v in parts.items()},
+        "loss": {k: v.imag / re for k, v in parts.items()},
+    }
+
+
+def operating_point(design: Design, frequency_hz: float, amplitude: float) -> dict:
+    """|K| (display unit) and loss factor at one frequency and amplitude (display)."""
+    r = stiffness(design, frequency_hz, units.to_si_amplitude(amplitude, design.mode))
+    return {"magnitude": float(units.display_stiffness(r.magnitude[0, 0], design.mode)),
+            "loss_factor": float(r.loss_factor[0, 0])}
+
+
+PADDING = 0.1  # of the data's span (in log10 on a log axis), on both sides together
+
+
+def padded(values, log: bool = False, pad: float = PADDING) -> tuple[float, float] | None:
+    """The axis range that shows ``values`` (arrays, any shapes) with ``pad`` of their span
+    added (in log10 on a log axis; two decades, or ±1, around a single value); None without a
+    finite (positive, on a log axis) value."""
+    parts = [np.ravel(np.asarray(v, dtype=float)) for v in values if v is not None]
+    data = np.concatenate(parts) if parts else np.empty(0)
+    data = data[np.isfinite(data) & ((data > 0) if log else True)]
+    if data.size == 0:
+        return None
+    low, high = float(data.min()), float(data.max())
+    if log:
+        low, high = np.log10(low), np.log10(high)
+    centre = (low + high) / 2
+    half = (high - low) * (1 + pad) / 2 if high > low else 1.0
+    start, end = centre - half, centre + half
+    return (float(10**start), float(10**end)) if log else (float(start), float(end))
+
+
+def measured_points(measured: MeasuredStiffness | None, mode: str) -> dict | None:
+    """Measured stiffness (SI) in display units, as the sweep plots draw it."""
+    if measured is None:
+        return None
+    return {"frequency_hz": measured.frequency_hz,
+            "amplitude": units.display_amplitude(measured.amplitude, mode),
+            "magnitude": units.display_stiffness(measured.magnitude, mode),
+            "loss_factor": measured.loss_factor}
+
+
+def measured_loop_points(measured_loop: MeasuredLoop | None, mode: str) -> dict | None:
+    """A measured loop (SI) centred, the drive in display units."""
+    if measured_loop is None:
+        return None
+    lp = measured_loop
+    return {"displacement": units.display_amplitude(lp.displacement - np.mean(lp.displacement), mode),
+            "force": lp.force - np.mean(lp.force)}
+
+
+class ExplorerData:
+    """Everything the explorer's five plots show for one design and operating point, in
+    display units: the curves (:mod:`app.curves`), the measured points and each plot's axis
+    ranges (shared by quantity). Built by :func:`explorer_data`."""
+
+    def __init__(self, **fields):
+        self.__dict__.update(fields)
+
+
+def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq_range=(1.0, 100.0),
+                  reference: Design | None = None, measured: MeasuredStiffness | None = None,
+                  measured_loop: MeasuredLoop | None = None, n_freq: int = 120, n_amp: int = 120) -> ExplorerData:
+    """The explorer's curves at the operating point (``frequency_hz``, ``amplitude`` in display
+    units). A reference in another mode than ``design`` is left out."""
+    mode = design.mode
+    f = np.linspace(*freq_range, n_freq)
+    x = amplitude_grid(design, n_amp)
+    ref = reference if reference is not None and reference.mode == mode else None
+    sweeps = {"frequency": frequency_sweep(design, f, sweep_amplitudes(design)),
+              "amplitude": amplitude_sweep(design, x, sweep_frequencies(*freq_range))}
+    operating = {"frequency": frequency_sweep(design, f, amplitude),
+                 "amplitude": amplitude_sweep(design, x, frequency_hz)}
+    references = ({"frequency": frequency_sweep(ref, f, amplitude),
+                   "amplitude": amplitude_sweep(ref, x, frequency_hz)} if ref is not None else None)
+    points = measured_points(measured, mode)
+    lp = hysteresis_loop(design, frequency_hz, amplitude)
+    ref_loop = hysteresis_loop(ref, frequency_hz, amplitude) if ref is not None else None
+    loop_points = measured_loop_points(measured_loop, mode)
+    ranges = {"frequency": padded([f]), "amplitude": padded([x], log=True)}
+    for quantity in ("magnitude", "loss_factor"):
+        parts = [s[quantity] for s in sweeps.values()] + [s[quantity] for s in operating.values()]
+        parts += [s[quantity] for s in references.values()] if references else []
+        parts += [points[quantity]] if points is not None else []
+        ranges[quantity] = padded(parts)
+    ranges["displacement"] = padded([lp["displacement"]] + ([ref_loop["displacement"]] if ref_loop else [])
+                                    + ([loop_points["displacement"]] if loop_points else []))
+    ranges["force"] = padded([lp["force"], lp["force_elastic"], lp["force_viscoelastic"], lp["force_friction"]]
+                             + ([ref_loop["force"]] if ref_loop else []) + ([loop_points["force"]] if loop_points else []))
+    return ExplorerData(mode=mode, frequency_hz=frequency_hz, amplitude=amplitude, sweeps=sweeps,
+                        operating=operating, references=references, measured=points, loop=lp,
+                        reference_loop=ref_loop, measured_loop=loop_points, ranges=ranges)
+
+
+# ---- a diagnosis (core.diagnose.Diagnosis) ---------------------------------------------------------
+
+
+def gap_stages(r) -> dict:
+    """The gap after each stage of a diagnosis: the baseline, then each added effect; and the
+    gap the noise alone gives (None if it could not be estimated)."""
+    labels = ["baseline"] + [f"+ {s.effect}" for s in r.steps]
+    gaps = [r.baseline.gap] + [s.gap_after for s in r.steps]
+    return {"stage": labels, "gap": np.array(gaps), "noise": r.noise_gap}
+
+
+def misfit_points(r, which: str) -> dict:
+    """Model − data of a diagnosis' ``which`` model ("baseline" or "final") at every measured
+    point: |K| in % and the loss factor, the amplitude in display units."""
+    k = (r.baseline if which == "baseline" else r.final).stiffness
+    d = r.data
+    return {
+        "frequency_hz": d.frequency_hz,
+        "amplitude": units.display_amplitude(d.amplitude, r.final.design.mode),
+        "magnitude_pct": 100 * (np.abs(k) / d.magnitude - 1),
+        "loss_factor": loss_factor(k) - d.loss_factor,
+    }
+
+
+def curve_groups(r, most: int = 5) -> list[dict]:
+    """Data and both models of a diagnosis against frequency, one group per measured amplitude
+    (the ``most`` most populated), in display units."""
+    d = r.data
+    mode = r.final.design.mode
+    groups = []
+    for amp in np.sort(d.amplitudes()[:most]):
+        sel = np.flatnonzero(d.amplitude == amp)
+        sel = sel[np.argsort(d.frequency_hz[sel])]
+        kb, kf, kd = r.baseline.stiffness[sel], r.final.stiffness[sel], d.stiffness[sel]
+        groups.append({
+            "amplitude": float(units.display_amplitude(amp, mode)),
+            "frequency_hz": d.frequency_hz[sel],
+            "data": (units.display_stiffness(np.abs(kd), mode), loss_factor(kd)),
+            "baseline": (units.display_stiffness(np.abs(kb), mode), loss_factor(kb)),
+            "final": (units.display_stiffness(np.abs(kf), mode), loss_factor(kf)),
+        })
+    return groups

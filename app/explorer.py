@@ -1,0 +1,115 @@
+"""The Explorer tab: the hysteresis loop at the operating point and |K| and the loss factor
+against frequency and amplitude (HoloViews, linked by shared dimensions), the comparison with a
+pinned reference."""
+
+from __future__ import annotations
+
+import holoviews as hv
+import panel as pn
+import param
+
+from . import plots
+from .live import LivePlot
+from .state import ExplorerState
+from .views import PlotView
+
+GRID = (("magnitude", "frequency"), ("magnitude", "amplitude"), ("loss_factor", "frequency"),
+        ("loss_factor", "amplitude"))
+
+
+class ExplorerPlots(PlotView):
+    """Loop, |K| and loss factor against frequency and amplitude, linked by the operating
+    point: a tap on a frequency plot sets the frequency, on an amplitude plot the amplitude."""
+
+    def __init__(self, state: ExplorerState, **params):
+        super().__init__(state, **params)
+        self.summary = pn.pane.HTML("", sizing_mode="stretch_width", css_classes=["operating-point"],
+                                    margin=(0, 10))
+        self.loop: LivePlot | None = None
+        self.grid: LivePlot | None = None
+        self.dims: dict = {}
+        self._mode = None
+        self._sweeps, self._sweeps_key = {}, None
+        self._update()  # built outside a held document: held, the new panes are laid out wrong
+
+    @param.depends("state.design", "state.freq_min", "state.freq_max", "state.errors", "state.frequency_hz",
+                   "state.amplitude", "state.reference", "state.measured", "state.measured_loop", watch=True)
+    def _on_state(self):
+        self.changed()
+
+    def frame(self, key) -> hv.Overlay:
+        """What a plot shows now: ``"loop"`` or a (quantity, against) pair of :data:`GRID`."""
+        return self.loop.current[0] if key == "loop" else self.grid.current[GRID.index(key)]
+
+    def _update(self):
+        s = self.state
+        data = s.explorer_data()
+        if data.mode != self._mode:
+            self.dims, self._mode = plots.dimensions(data.mode), data.mode  # new units: new axes
+        key = (s.design, s.freq_range)
+        if key != self._sweeps_key:  # the sweeps change with the design, not the operating point
+            labels = plots.explorer_labels(data)
+            self._sweeps = {k: plots.sweep_curves(*k, data.sweeps[k[1]], self.dims, labels[k[1]]) for k in GRID}
+            self._sweeps_key = key
+        overlays = plots.explorer_overlays(data, self.dims, self._sweeps)
+        grid = [overlays[k] for k in GRID]
+        if self.grid is None:
+            taps = {i: self.tap_frequency if against == "frequency" else self.tap_amplitude
+                    for i, (_quantity, against) in enumerate(GRID)}
+            self.loop = LivePlot([overlays["loop"]], linked=True)
+            self.grid = LivePlot(grid, taps=taps, linked=True)
+        else:
+            self.loop.show([overlays["loop"]])
+            self.grid.show(grid)
+        point = s.operating_point()
+        self.summary.object = (
+            f'<span class="op-summary"><b>Operating point</b>: <span class="op-point">{s.amplitude:.3g} '
+            f"{s.amplitude_unit}, {s.frequency_hz:.3g} Hz</span> &nbsp;→&nbsp; |K| = "
+            f"<b>{point['magnitude']:.4g} {s.stiffness_unit}</b>, loss factor <b>{point['loss_factor']:.4f}</b></span>"
+        )
+
+    def __panel__(self):
+        return pn.Column(self.summary, self.loop.pane, self.grid.grid(2), sizing_mode="stretch_width")
+
+
+def pct(value: float) -> str:
+    """A signed percentage to 2 decimals, without a "-0.00" from round-off."""
+    return f"{0.0 if abs(value) < 0.005 else value:+.2f} %"
+
+
+class CompareView(pn.viewable.Viewer):
+    """Pin the current design as a reference; show the differences in %."""
+
+    def __init__(self, state: ExplorerState, **params):
+        super().__init__(**params)
+        self.state = state
+        self.pin = pn.widgets.Button(label="Pin as reference", color="primary", description="Keep this design to compare the next ones with it (dashed curves).")
+        self.clear = pn.widgets.Button(label="Clear reference", color="light")
+        self.pin.on_click(lambda _e: state.pin_reference())
+        self.clear.on_click(lambda _e: state.clear_reference())
+
+    def table(self, reference, design, f, x, errors):
+        c = self.state.comparison()
+        if c is None:
+            return "_No reference pinned: press **Pin as reference**, then change the design._"
+        if reference.mode != design.mode:
+            return "_The reference is in another mode; switch back to compare._"
+        unit = self.state.stiffness_unit
+        (m_now, m_ref, m_d), (e_now, e_ref, e_d) = c["operating"]["magnitude"], c["operating"]["loss_factor"]
+        return (
+            f"| at {f:.3g} Hz, {x:.3g} {self.state.amplitude_unit} | this design | reference | difference |\n|---|---|---|---|\n"
+            f"| \\|K\\| ({unit}) | {m_now:.4g} | {m_ref:.4g} | {pct(m_d)} |\n"
+            f"| loss factor | {e_now:.4f} | {e_ref:.4f} | {pct(e_d)} |\n\n"
+            f"Largest difference over the frequency sweep: \\|K\\| {pct(c['largest_over_frequency']['magnitude'])}, "
+            f"loss factor {pct(c['largest_over_frequency']['loss_factor'])}; over the amplitude sweep: "
+            f"\\|K\\| {pct(c['largest_over_amplitude']['magnitude'])}, loss factor {pct(c['largest_over_amplitude']['loss_factor'])}."
+        )
+
+    def __panel__(self):
+        s = self.state.param
+        return pn.Column(
+            pn.Row(self.pin, self.clear),
+            pn.pane.Markdown(pn.bind(self.table, s.reference, s.design, s.frequency_hz, s.amplitude, s.errors),
+                             sizing_mode="stretch_width", css_classes=["comparison"]),
+            sizing_mode="stretch_width",
+        )

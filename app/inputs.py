@@ -1,0 +1,178 @@
+"""The input panel: design fields with their units, messages and help, the operating point's
+sliders, and the status line above the tabs. Widgets write the state; the state validates."""
+
+from __future__ import annotations
+
+import math
+import typing
+
+import panel as pn
+from bokeh.models import CustomJSTickFormatter
+
+from core.bushing import STRUCTURAL_EFFECTS
+
+from .state import DESIGN_FIELDS, ExplorerState
+from .units import OPERATING_FREQUENCIES
+
+
+class FloatInput(pn.widgets.FloatInput):
+    """Panel's FloatInput without the 50 ms debounce on its value: every edit answers at once
+    (Panel marks such properties as priority changes, as its Tabulator does for its data)."""
+
+    _priority_changes: typing.ClassVar[list[str]] = ["value"]
+
+
+class FloatSlider(pn.widgets.FloatSlider):
+    """Panel's FloatSlider without the 50 ms debounce on its value (see :class:`FloatInput`)."""
+
+    _priority_changes: typing.ClassVar[list[str]] = ["value"]
+
+
+class LogSlider(pn.viewable.Viewer):
+    """A slider over log10 of a positive state parameter that shows the value and its unit."""
+
+    def __init__(self, state: ExplorerState, name: str, bounds, unit, **params):
+        super().__init__(**params)
+        self._state, self._name, self._bounds, self._unit = state, name, bounds, unit
+        p = state.param[name]
+        lo, hi = bounds()
+        self.slider = FloatSlider(
+            label=self._label(),
+            start=math.log10(lo),
+            end=math.log10(hi),
+            step=0.005,
+            value=self._clip(math.log10(getattr(state, name))),
+            format=self._formatter(),
+            sizing_mode="stretch_width",
+        )
+        self.help = pn.widgets.TooltipIcon(value=p.doc, width=20, margin=(28, 6, 0, 0))
+        self.slider.param.watch(self._from_slider, "value")
+        state.param.watch(self._from_state, name)
+        state.param.watch(self._rescale, "design")
+
+    def _label(self):
+        return f"{self._state.param[self._name].label} ({self._unit()})"
+
+    def _formatter(self):
+        return CustomJSTickFormatter(code="return Number(Math.pow(10, tick).toPrecision(3)).toString()")
+
+    def _clip(self, v):
+        lo, hi = self._bounds()
+        return min(max(v, math.log10(lo)), math.log10(hi))
+
+    def _from_slider(self, event):
+        value = float(f"{10 ** event.new:.4g}")
+        if not math.isclose(value, getattr(self._state, self._name), rel_tol=1e-3):
+            setattr(self._state, self._name, value)
+
+    def _from_state(self, event):
+        v = self._moved_to(event.new)
+        if v is not None:
+            self.slider.value = v
+
+    def _moved_to(self, value):
+        """Where the slider must go to show a value set elsewhere (a tap, a link, a preset), or
+        None: not back to the 4-digit rounding of its own value, which would send every move
+        back to the browser."""
+        v = self._clip(math.log10(value))
+        lo, hi = self._bounds()
+        inside = math.log10(lo) <= self.slider.value <= math.log10(hi)
+        return v if abs(v - self.slider.value) > self.slider.step / 2 or not inside else None
+
+    def _rescale(self, _event):
+        """New bounds (and unit) for a new design; Panel sends only what changed."""
+        lo, hi = self._bounds()
+        changes = {"start": math.log10(lo), "end": math.log10(hi), "label": self._label()}
+        v = self._moved_to(getattr(self._state, self._name))
+        if v is not None:
+            changes["value"] = v
+        self.slider.param.update(**changes)
+
+    def __panel__(self):
+        return pn.Row(self.slider, self.help, sizing_mode="stretch_width")
+
+
+def error_text(state: ExplorerState, name: str):
+    """The message beside a widget: what is wrong with its value, or nothing."""
+
+    def render(errors):
+        msg = errors.get(name)
+        return f'<div class="field-error" data-field="{name}">⚠ {msg}</div>' if msg else ""
+
+    return pn.pane.HTML(pn.bind(render, state.param.errors), margin=(0, 10, 4, 10),
+                        styles={"color": "#b03a2e", "font-size": "0.9em"}, sizing_mode="stretch_width")
+
+
+class DesignInputs(pn.viewable.Viewer):
+    """Mode, geometry, material, operating point and sweep range, each with unit and help."""
+
+    def __init__(self, state: ExplorerState, **params):
+        super().__init__(**params)
+        self.state = state
+        steps = {"fractional_order": 0.05, "friction_strain_half": 5e-4}
+        self.widgets = {
+            name: FloatInput.from_param(
+                state.param[name], description=state.param[name].doc, step=steps.get(name, 0.5),
+                sizing_mode="stretch_width", label=state.param[name].label,
+            )
+            for name in DESIGN_FIELDS
+        }
+        for name in ("freq_min", "freq_max"):
+            self.widgets[name] = FloatInput.from_param(
+                state.param[name], description=state.param[name].doc, step=1.0,
+                sizing_mode="stretch_width", label=state.param[name].label,
+            )
+        self.preset = pn.widgets.Select.from_param(
+            state.param.preset, description=state.param.preset.doc, sizing_mode="stretch_width",
+        )
+        self.mode = pn.widgets.RadioButtonGroup.from_param(
+            state.param.mode, description=state.param.mode.doc, color="primary",
+            variant="outline", sizing_mode="stretch_width",
+        )
+        self.amplitude = LogSlider(state, "amplitude", lambda: state.amplitude_bounds, lambda: state.amplitude_unit)
+        self.frequency = LogSlider(state, "frequency_hz", lambda: OPERATING_FREQUENCIES, lambda: "Hz")
+
+    def _field(self, name):
+        return pn.Column(self.widgets[name], error_text(self.state, name), margin=0, sizing_mode="stretch_width")
+
+    def __panel__(self):
+        geometry = [self._field(n) for n in ("inner_radius_mm", "outer_radius_mm", "length_mm")]
+        material = [self._field(n) for n in list(DESIGN_FIELDS)[3:]]
+        return pn.Column(
+            self.preset,
+            self.mode,
+            pn.pane.Markdown("**Operating point**", margin=(8, 10, 0, 10)),
+            self.amplitude,
+            self.frequency,
+            pn.Card(*geometry, title="Geometry", collapsed=False, sizing_mode="stretch_width"),
+            pn.Card(*material, title="Material", collapsed=False, sizing_mode="stretch_width"),
+            pn.Card(self._field("freq_min"), self._field("freq_max"), title="Frequency sweep",
+                    sizing_mode="stretch_width"),
+            sizing_mode="stretch_width",
+        )
+
+
+def status_banner(state: ExplorerState):
+    """One line above the tabs: the design's name, or what is wrong with the input. A pane whose
+    text changes in place (no re-layout)."""
+
+    def render(errors, design):
+        if errors:
+            fields = ", ".join(state.param[n].label for n in errors if n in state.param)
+            return (
+                '<div class="input-errors" style="background:#fff3cd;border:1px solid #ffe69c;'
+                'padding:8px 12px;border-radius:6px;color:#664d03">'
+                f"Some inputs are not valid ({fields}): see the messages beside them. "
+                "The plots show the last valid design.</div>"
+            )
+        effects = ", ".join(design.effect_parameters) if design.effects else ""
+        name = design.name or "Custom design"
+        text = f"<b>{name}</b>, {design.mode}" + (f"; effects: {effects}" if effects else "")
+        structural = [e for e in design.effect_parameters if e in STRUCTURAL_EFFECTS]
+        if structural:
+            text += (f" ({', '.join(structural)} act on the stiffness plots; the loop, slices and "
+                     "branches show the material model)")
+        return text
+
+    return pn.pane.HTML(pn.bind(render, state.param.errors, state.param.design),
+                        sizing_mode="stretch_width", margin=(4, 10))

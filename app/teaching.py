@@ -1,0 +1,97 @@
+"""The Fletcher–Gent tab: how the elastic, viscoelastic and friction branches make up the
+stiffness as the amplitude grows, and the loop changing shape as a player sweeps the amplitude."""
+
+from __future__ import annotations
+
+import numpy as np
+import panel as pn
+import param
+
+from . import plots
+from .curves import padded
+from .live import LivePlot, update_or_keep
+from .state import ExplorerState
+from .views import PlotView
+
+TEACHING_TEXT = """
+**Why filled rubber softens and dissipates more as the amplitude grows.** The stress is the sum of
+three branches driven by the same strain. The **elastic** branch (blue) is a spring: it stores and
+gives back. The **viscoelastic** branch (green) depends on the rate: it adds stiffness and a
+constant share of loss at every amplitude. The **friction** branch (red) is the carbon-black
+filler network: at small amplitude it is stiff and nearly elastic; as the amplitude passes ε½ it
+slips, its stiffness falls away and it dissipates most, hence the loss factor's peak; at large
+amplitude it saturates at σ_fmax and both its stiffness and its share of the loss fade. Press play
+to watch the loop change shape: a thin ellipse at small amplitude, a fat friction loop near the
+knee, a sheared parallelogram at large amplitude.
+"""
+
+WHICH = ("real", "loss")
+
+
+class TeachingView(PlotView):
+    """The Fletcher–Gent effect branch by branch, and the loop changing as amplitude sweeps."""
+
+    FRAMES = 48
+
+    def __init__(self, state: ExplorerState, **params):
+        super().__init__(state, **params)
+        self.player = pn.widgets.Player(
+            label="Amplitude sweep", start=0, end=self.FRAMES - 1, value=self.FRAMES // 2,
+            loop_policy="loop", interval=150, show_value=False, show_loop_controls=False,
+            sizing_mode="stretch_width",
+        )
+        self.frame_label = pn.pane.HTML("", css_classes=["loop-frame"], margin=(0, 10))
+        self.branches: LivePlot | None = None
+        self.loop: LivePlot | None = None
+        self.player.param.watch(lambda _e: self._frame(), "value")
+        self._update()  # built outside a held document: held, the new panes are laid out wrong
+
+    @param.depends("state.design", "state.errors", "state.frequency_hz", "state.amplitude", watch=True)
+    def _on_state(self):
+        self.changed()
+
+    def frame(self, which: str):
+        """What a plot shows now: "real", "loss" (the branches) or "loop" (the loop's shape)."""
+        return self.loop.current[0] if which == "loop" else self.branches.current[WHICH.index(which)]
+
+    def _update(self):
+        d = self.state.branch_breakdown()
+        mode = self.state.design.mode
+        if mode != getattr(self, "_mode", None):
+            self.dims, self._mode = plots.dimensions(mode), mode
+            self.dims["drive_rel"].range, self.dims["force_rel"].range = (-1.05, 1.05), (-1.1, 1.1)
+        totals = {which: sum(d[which].values()) for which in WHICH}
+        self.dims["amplitude"].range = padded([d["amplitude"]], log=True)
+        self.dims["real"].range = padded([np.zeros(1), totals["real"]])
+        self.dims["branch_loss"].range = padded([np.zeros(1), totals["loss"]])
+        overlays = plots.branch_overlays(d, self.dims, self.state.amplitude)
+        items = [overlays[w] for w in WHICH]
+        if self.branches is None:
+            self.branches = LivePlot(items, taps={0: self.tap_amplitude, 1: self.tap_amplitude})
+        else:
+            self.branches.show(items)
+        self._draw_frame()
+
+    def _frame(self):
+        update_or_keep("TeachingView kept its last frame", self._draw_frame)
+
+    def _draw_frame(self):
+        x = np.geomspace(*self.state.amplitude_bounds, self.FRAMES)[self.player.value]
+        shape = plots.loop_shape_overlay(self.state.hysteresis_loop(amplitude=x), self.dims)
+        if self.loop is None:
+            self.loop = LivePlot([shape])
+        else:
+            self.loop.show([shape])
+        self.frame_label.object = (f'<span class="frame-point">Loop shape at <b>{x:.3g} '
+                                   f"{self.state.amplitude_unit}</b>, {self.state.frequency_hz:.3g} Hz</span>")
+
+    def __panel__(self):
+        return pn.Column(
+            pn.pane.Markdown(TEACHING_TEXT, sizing_mode="stretch_width"),
+            pn.Row(
+                pn.Column(*self.branches.panes, sizing_mode="stretch_width"),
+                pn.Column(self.player, self.frame_label, self.loop.pane, sizing_mode="stretch_width"),
+                sizing_mode="stretch_width",
+            ),
+            sizing_mode="stretch_width",
+        )
