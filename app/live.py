@@ -11,10 +11,12 @@ Three costs that were measured here and are avoided (explorer, Chromium, this ma
 * **Unchanged data are not re-sent.** An element whose data equal the previous frame's is
   replaced by the previous element itself; HoloViews then keeps the glyph's data source as it is
   (it compares the element's plot id), and the browser repaints only what changed.
-* **One document freeze per change** (:func:`send`). Each HoloViews plot update freezes the
-  Bokeh document, and every unfreeze walks the whole document to recompute its models (about a
-  third of the server's time per change with five plots). Inside one outer freeze, the walk
-  happens once, when the last plot has been updated; one ``hold`` sends every change in one
+* **One document freeze per change, and no model walk after it unless models were added**
+  (:func:`one_change`). Each HoloViews plot update freezes the Bokeh document, and every
+  unfreeze walks the whole document to recompute its models (measured: a third of the server's
+  time per change with five plots, each walk 24 ms). Inside one outer freeze
+  (:func:`app.patches.frozen_models`) the plots' own freezes walk nothing, and the outer one
+  walks only if the change added or removed models; one ``hold`` sends every change in one
   message.
 * **No WebGL** (:mod:`app.plots`).
 """
@@ -29,11 +31,14 @@ import holoviews as hv
 import numpy as np
 import panel as pn
 
+from . import patches
+
 log = logging.getLogger("bushing.app")
 
 
 def _same_data(a: hv.Element, b: hv.Element) -> bool:
-    """Whether two elements of the same kind hold the same values in the same columns."""
+    """Whether two elements of the same kind hold the same values in the same columns (the value
+    columns first: after a change of the design they differ, and the comparison stops there)."""
     if a is b:
         return True
     if type(a) is not type(b) or a.label != b.label or a.group != b.group:
@@ -43,7 +48,7 @@ def _same_data(a: hv.Element, b: hv.Element) -> bool:
     dims_a, dims_b = a.dimensions(), b.dimensions()
     if [(d.name, d.label, d.unit) for d in dims_a] != [(d.name, d.label, d.unit) for d in dims_b] or len(a) != len(b):
         return False
-    for i in range(len(dims_a)):
+    for i in reversed(range(len(dims_a))):
         x, y = a.dimension_values(i), b.dimension_values(i)
         if x.dtype.kind == "f" and y.dtype.kind == "f":
             if not np.array_equal(x, y, equal_nan=True):
@@ -84,21 +89,19 @@ class LivePlot:
 
     def _build(self, overlays: list) -> list:
         self.pipe = hv.streams.Pipe(data=overlays)
-        self.dmaps = [hv.DynamicMap(lambda data, i=i: data[i], streams=[self.pipe]) for i in range(len(overlays))]
-        self.tap_streams = []
-        shown = list(self.dmaps)
-        for index, callback in self.taps.items():
-            # HoloViews links a Tap stream to an element's plot, not to a DynamicMap of overlays:
-            # the stream's source is an empty element overlaid on the plot (no legend, no extent)
-            first = overlays[index].get(0)
-            anchor = hv.Scatter([], first.kdims, first.vdims)
-            tap = hv.streams.Tap(source=anchor, transient=True)
-            tap.add_subscriber(lambda x=None, y=None, callback=callback: callback(x))
-            self.tap_streams.append(tap)
-            options = {**hv.Store.lookup_options("bokeh", overlays[index], "plot").kwargs,
-                       **hv.Store.lookup_options("bokeh", overlays[index], "norm").kwargs}
-            shown[index] = (self.dmaps[index] * anchor).opts(clone=False, **options)  # the overlay's title, size…
-        return shown
+        self.dmaps, self.tap_streams = [], []
+        for i in range(len(overlays)):
+            streams = [self.pipe]
+            if i in self.taps:
+                # among the DynamicMap's own streams, HoloViews links the Tap to the plot of the
+                # overlay the DynamicMap returns (a Tap with the DynamicMap as its source only,
+                # it links to nothing)
+                tap = hv.streams.Tap(transient=True)
+                tap.add_subscriber(lambda x=None, y=None, callback=self.taps[i]: callback(x))
+                self.tap_streams.append(tap)
+                streams.append(tap)
+            self.dmaps.append(hv.DynamicMap(lambda data, x=None, y=None, i=i: data[i], streams=streams))
+        return self.dmaps
 
     @property
     def pane(self):
@@ -125,12 +128,13 @@ class LivePlot:
 @contextlib.contextmanager
 def one_change():
     """Hold the document (every change goes to the browser in one message) and freeze its
-    models (recomputed once, at the end, instead of after each plot's update)."""
+    models (recomputed at the end, once and only if models were added or removed, instead of
+    after each plot's update)."""
     doc = pn.state.curdoc
     if doc is None:
         yield
         return
-    with pn.io.hold(doc), doc.models.freeze():
+    with pn.io.hold(doc), patches.frozen_models(doc):
         yield
 
 

@@ -482,3 +482,50 @@ def test_the_slider_keeps_its_own_position(app):
     lo, hi = app.state.amplitude_bounds
     assert np.log10(lo) <= slider.value <= np.log10(hi)
     assert abs(slider.value - np.log10(app.state.amplitude)) <= slider.step / 2
+
+
+def test_a_change_walks_the_document_only_when_it_adds_models(app):
+    """app.patches.frozen_models: a change that only moves data recomputes no model set; one that
+    adds glyphs (a pinned reference) does, so the new models are in the document."""
+    from bokeh.models import GlyphRenderer
+    from panel.io.state import set_curdoc
+
+    doc = rendered(app.template())
+    with set_curdoc(doc):  # the first change gives the text panes the template's theme (new models)
+        app.state.shear_modulus_mpa = 2.7
+    walks = []
+    recompute = doc.models.recompute
+    doc.models.recompute = lambda: walks.append(1) or recompute()
+    with set_curdoc(doc):
+        app.state.shear_modulus_mpa = 2.8
+        app.state.amplitude = 0.2
+        assert walks == []
+        app.state.pin_reference()
+        app.state.length_mm = 80.0
+    assert walks
+    fig = figures(doc)["|K| against frequency"]
+    (reference,) = [r for item in fig.legend[0].items if item.label["value"] == "reference" for r in item.renderers]
+    assert isinstance(reference, GlyphRenderer) and doc.get_model_by_id(reference.id) is reference
+    assert doc.get_model_by_id(reference.data_source.id) is reference.data_source
+
+
+def test_the_private_internals_used_are_there():
+    """app.patches relies on these Bokeh internals (checked against Bokeh 3.9)."""
+    from bokeh.document.models import DocumentModelManager
+
+    for name in ("_freeze_count", "_push_freeze", "_pop_freeze", "invalidate", "recompute"):
+        assert hasattr(DocumentModelManager, name) or name == "_freeze_count"
+    from bokeh.document import Document
+
+    assert Document().models._freeze_count == 0
+
+
+def test_the_state_and_the_curves_need_no_panel_and_no_plotting():
+    """The session's state and the curves are plain Python: usable without a server or a plot."""
+    import subprocess
+    import sys
+
+    code = ("import sys, app.state, app.curves, app.diagnosis_state; "
+            "print(sorted(m for m in ('panel', 'holoviews', 'bokeh') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
