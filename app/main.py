@@ -9,7 +9,7 @@ import sys
 import panel as pn
 import param
 
-from . import patches  # noqa: F401 - Panel's page resources (see the module)
+from . import patches
 from .diagnosis import DiagnosisView
 from .diagnosis_state import DiagnosisState
 from .explorer import CompareView, ExplorerPlots
@@ -183,6 +183,8 @@ def create_app():
     """Factory for one session (served per connection, so sessions never share state)."""
     app = App()
     app.sync_url()
+    if pn.state.curdoc is not None and os.environ.get("BUSHING_BOKEHJS_PATCHES", "1") == "1":
+        patches.install_bokehjs_patches(pn.state.curdoc)
     return app.template()
 
 

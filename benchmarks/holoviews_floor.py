@@ -41,11 +41,15 @@ def floor_session(n_figures: int):
     options = {"logx": True, "framewise": True, "responsive": True, "height": 300, "toolbar": None,
                "show_legend": False}
 
+    # styled once, cloned with new data per frame (a clone keeps its options: no lookup per frame)
+    curve = hv.Curve([], f, "q").opts(framewise=True)
+    plot = hv.Overlay([]).opts(**options)
+    ys = [hv.Dimension(f"q{i}", label=f"Quantity {i}") for i in range(n_figures)]
+
     def overlay(i):
-        y = hv.Dimension(f"q{i}", label=f"Quantity {i}")
-        curves = [hv.Curve((x, mu.value * (1 + k) * np.log1p(x * (i + 1)) / (1 + 10**amp.value * x)), f, y)
-                  .opts(framewise=True) for k in range(N_CURVES)]
-        return hv.Overlay(curves).opts(**options)
+        curves = [curve.clone((x, mu.value * (1 + k) * np.log1p(x * (i + 1)) / (1 + 10**amp.value * x)),
+                              kdims=[f], vdims=[ys[i]]) for k in range(N_CURVES)]
+        return plot.clone(curves)
 
     pipes = [hv.streams.Pipe(data=overlay(i)) for i in range(n_figures)]
     panes = [pn.pane.HoloViews(hv.DynamicMap(lambda data: data, streams=[p]), sizing_mode="stretch_width",

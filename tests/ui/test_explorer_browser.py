@@ -339,3 +339,63 @@ def test_a_slider_drag_is_one_history_entry(page, explorer_url):
     page.locator(".bk-Canvas").nth(4).wait_for(timeout=30000)
     wait_quiet(page)
     assert page.get_by_label("Shear modulus µ (MPa)").input_value() == "2.8"
+
+
+# For every glyph renderer of the page's plots: where its element is, and where Bokeh's own
+# code would put it (the box of its data on screen, or hidden without valid data).
+GLYPH_BOXES_JS = """() => {
+  const out = [];
+  for (const v of Bokeh.index.all_views()) {
+    if (v.model == null || v.model.type !== 'GlyphRenderer' || v.el == null) continue;
+    const box = v.bbox, style = v.el.style;
+    const expected = box != null && box.is_valid
+      ? [box.left, box.top, box.width, box.height, ''] : [null, null, null, null, 'none'];
+    const px = (text) => text.endsWith('px') ? parseFloat(text) : text;
+    const shown = style.display === 'none' ? [null, null, null, null, 'none']
+      : [px(style.left), px(style.top), px(style.width), px(style.height), style.display];
+    out.push({expected, shown, sheet: v.position.css ?? v.position.el?.textContent ?? ''});
+  }
+  return out;
+}"""
+
+# A `--bk-axis-line-color` variable on an axis' element is Bokeh's CSS theming: the cached
+# reads must honour it at the next paint, and forget it once removed.
+CSS_THEME_JS = """async (title) => {
+  const fig = [...Bokeh.documents[0].all_models].find(m => m.type === 'Figure' && m.title && m.title.text === title);
+  const line = Bokeh.index.find_one(fig.below[0]).visuals.axis_line, el = line.obj.el;
+  const read = () => line.get_line_color();
+  const frame = () => new Promise(r => requestAnimationFrame(() => setTimeout(r, 0)));
+  const before = read();
+  el.style.setProperty('--bk-axis-line-color', 'rgb(1, 2, 3)');
+  await frame();
+  const themed = read();
+  el.style.removeProperty('--bk-axis-line-color');
+  await frame();
+  return [before, themed, read()];
+}"""
+
+
+def same_box(shown, expected):
+    """The same box to the 0.001 px that the browser keeps of an inline length."""
+    return shown[4] == expected[4] and all(
+        a == b if a is None or b is None else abs(a - b) < 1e-3 for a, b in zip(shown[:4], expected[:4]))
+
+
+def test_bokehjs_paint_patches_keep_bokehs_behaviour(page, explorer_url):
+    """The three BokehJS patches of app/patches.py are active, and what they change still behaves
+    as Bokeh's own code: glyph elements sit on their data's box, CSS theming still applies."""
+    open_explorer(page, explorer_url)
+    assert page.evaluate("() => [window.bushingStyleWrites, window.bushingCssReads, window.bushingGlyphPosition]") \
+        == ["skip-unchanged", "cached-per-task", "inline-style"]
+    page.get_by_label("Shear modulus µ (MPa)").fill("2.7")
+    page.get_by_label("Shear modulus µ (MPa)").press("Enter")
+    wait_quiet(page)
+    boxes = page.evaluate(GLYPH_BOXES_JS)
+    # with data on screen: the loop's three branches and total; against frequency four sweeps and
+    # the operating curve, against amplitude three and the operating curve
+    assert sum(b["expected"][4] == "" for b in boxes) == 4 + 2 * 5 + 2 * 4
+    assert [b for b in boxes if not same_box(b["shown"], b["expected"])] == []
+    assert all(b["sheet"].strip() == "" for b in boxes)  # the box is in the inline style only
+    before, themed, after = page.evaluate(CSS_THEME_JS, "|K| against frequency")
+    assert themed == "rgb(1, 2, 3)"
+    assert before == after != themed
