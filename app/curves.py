@@ -8,6 +8,7 @@ asking twice for the same curve costs a look-up.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -171,13 +172,22 @@ def measured_loop_points(measured_loop: MeasuredLoop | None, mode: str) -> dict 
             "force": lp.force - np.mean(lp.force)}
 
 
+@dataclass(frozen=True)
 class ExplorerData:
     """Everything the explorer's five plots show for one design and operating point, in
-    display units: the curves (:mod:`app.curves`), the measured points and each plot's axis
-    ranges (shared by quantity). Built by :func:`explorer_data`."""
+    display units. Built by :func:`explorer_data`."""
 
-    def __init__(self, **fields):
-        self.__dict__.update(fields)
+    mode: str
+    frequency_hz: float
+    amplitude: float
+    sweeps: dict  # "frequency": frequency_sweep at the sweep amplitudes; "amplitude": amplitude_sweep
+    operating: dict  # the same at the operating amplitude / frequency (one row each)
+    references: dict | None  # the same for the pinned reference design, if any (same mode)
+    measured: dict | None  # measured_points
+    loop: dict  # hysteresis_loop at the operating point
+    reference_loop: dict | None
+    measured_loop: dict | None  # measured_loop_points
+    ranges: dict  # axis name → (start, end), shared by every plot of that quantity
 
 
 def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq_range=(1.0, 100.0),

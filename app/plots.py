@@ -279,7 +279,7 @@ def sized(layout: hv.Layout, width: int | None) -> hv.Layout:
     are (filling the width of their container) for None."""
     if width is None:
         return layout
-    return layout.opts(hv.opts.Overlay(responsive=False, width=width), hv.opts.Layout(shared_axes=True))
+    return layout.map(lambda overlay: overlay.opts(responsive=False, width=width), [hv.Overlay])
 
 
 def explorer_plots(design: Design, frequency_hz: float = 10.0, amplitude: float | None = None, *,
