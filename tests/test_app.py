@@ -529,3 +529,20 @@ def test_the_state_and_the_curves_need_no_panel_and_no_plotting():
             "print(sorted(m for m in ('panel', 'holoviews', 'bokeh') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_changes_add_no_styles_and_no_options_entries(app):
+    """Every plotted element is a clone of a styled template: changes add no template and no
+    entry to HoloViews' options store (a session's memory stays flat however long it runs)."""
+    import holoviews as hv
+
+    from app import plots
+
+    app.state.shear_modulus_mpa = 2.5  # every style in use once
+    app.state.amplitude = 0.3
+    templates, entries = plots._template.cache_info().currsize, len(hv.Store.custom_options())
+    for i in range(15):
+        app.state.shear_modulus_mpa = 2.0 + 0.01 * i
+        app.state.amplitude = 0.05 + 0.01 * i
+    assert plots._template.cache_info().currsize == templates
+    assert len(hv.Store.custom_options()) == entries
