@@ -40,6 +40,16 @@ check against the thesis' time-domain simulation.
 **Units.** Radii and length in mm; µ and m in MPa (m in MPa·s^α); σ_fmax in kPa; ε½ and α
 plain numbers; the drive in mm (axial) or rad (torsion), as peak values. |K| in kN/mm (= MN/m)
 axially and N·m/rad in torsion. Files and the command line use SI.
+
+**Files.** *Measured stiffness* (CSV): a header row `frequency_hz,amplitude,magnitude,loss_factor`
+(or `stiffness_real,stiffness_imag` instead of the last two), then one row per point; amplitude
+the peak displacement in m (axial) or angle in rad (torsion), |K| in N/m or N·m/rad. *Measured
+loop* (CSV): `time_s,displacement,force`, one or more periods of a steady harmonic test. *Design
+file* (JSON): `mode`, `geometry` (`inner_radius`, `outer_radius`, `length` in m), `material`
+(`shear_modulus`, `fractional_coefficient` and `friction_stress_max` in Pa, `fractional_order`,
+`friction_strain_half`), optionally `name` and `effects`. A row or key that is missing, not a
+number or out of range is refused with its line or key. The repository's `docs/` describe the
+model (with the thesis' equation numbers), every file and the `bushing` command line.
 """
 
 

@@ -69,7 +69,7 @@ def _number(doc, label, default, **kw):
 
 def read_measured(parse, content: bytes | str, filename: str):
     """``(parse(content), "")``, or ``(None, message)`` naming the file and what is wrong with it
-    (a file the formats of FORMATS.md refuse)."""
+    (a file the formats of docs/files.md refuse)."""
     try:
         return parse(content), ""
     except DataError as exc:
@@ -208,7 +208,7 @@ class ExplorerState(param.Parameterized):
     # ---- measured data and fitting -----------------------------------------------------------
 
     def load_measured(self, content: bytes | str, filename: str = "stiffness file") -> bool:
-        """Read a measured-stiffness CSV (FORMATS.md); on a bad file say why and keep the last."""
+        """Read a measured-stiffness CSV (docs/files.md); on a bad file say why and keep the last."""
         data, self.data_message = read_measured(parse_stiffness, content, filename)
         if data is None:
             return False
@@ -432,7 +432,7 @@ class ExplorerState(param.Parameterized):
     # ---- export ------------------------------------------------------------------------------
 
     def stiffness_table(self, n_freq: int = 25, n_amp: int = 25) -> dict:
-        """The FORMATS.md stiffness table over the sweeps' frequency range and the
+        """The docs/files.md stiffness table over the sweeps' frequency range and the
         Fletcher–Gent amplitude range (SI units)."""
         r = stiffness(self.design, self.frequency_grid(n_freq), self._si_amplitude(self.amplitude_grid(n_amp)))
         return r.table()

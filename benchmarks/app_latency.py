@@ -1,4 +1,4 @@
-"""Explorer latency in real Chromium (issue 3): prints figures, asserts nothing.
+"""Explorer latency in real Chromium: prints figures, asserts nothing.
 
     python benchmarks/app_latency.py [--changes 40] [--sessions 10]
 
@@ -113,7 +113,7 @@ def free_port():
 def start_server(port, command=None, probe="/liveness"):
     """Start the explorer (or ``command``, another server) and wait until ``probe`` answers."""
     proc = subprocess.Popen(
-        command or [sys.executable, "-m", "core.cli", "serve", "--port", str(port)],
+        command or [sys.executable, "-m", "app.cli", "serve", "--port", str(port)],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )
     deadline = time.time() + 60

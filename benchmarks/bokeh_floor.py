@@ -1,4 +1,4 @@
-"""The floor under the explorer's latency: plain Bokeh, same protocol (issue 3). Prints figures.
+"""The floor under the explorer's latency: plain Bokeh, same protocol. Prints figures.
 
     python benchmarks/bokeh_floor.py [--figures 5] [--changes 30] [--sessions 10] [--explorer]
 

@@ -1,4 +1,4 @@
-"""Speed of the core (issue 2): prints figures and ratios, asserts nothing.
+"""Speed of the core: prints figures and ratios, asserts nothing.
 
     python benchmarks/core_speed.py
 

@@ -1,4 +1,4 @@
-"""Speed of the discrepancy workflow (issue 5): prints figures, asserts nothing.
+"""Speed of the discrepancy workflow: prints figures, asserts nothing.
 
     python benchmarks/diagnose_speed.py
 

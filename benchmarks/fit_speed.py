@@ -1,4 +1,4 @@
-"""Speed of parameter identification (issue 4): prints figures, asserts nothing.
+"""Speed of parameter identification: prints figures, asserts nothing.
 
     python benchmarks/fit_speed.py
 

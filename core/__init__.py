@@ -1,7 +1,7 @@
 """Bushing Explorer's computational core: pure NumPy/SciPy, no user interface.
 
 Dynamic stiffness of carbon-black-filled rubber bushings in torsion and axially, over
-frequency and amplitude, after García Tárrago (KTH, 2006). See MODEL.md for the physics.
+frequency and amplitude, after García Tárrago (KTH, 2006). See docs/model.md for the physics.
 """
 
 from .bushing import (

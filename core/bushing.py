@@ -99,7 +99,7 @@ class StiffnessResult(ComplexStiffness):
         return {"frequency_hz": "Hz", **UNITS[self.mode]}
 
     def table(self) -> dict[str, np.ndarray]:
-        """Flat columns in FORMATS.md's order, amplitude by amplitude, each a frequency sweep."""
+        """Flat columns in docs/files.md's order, amplitude by amplitude, each a frequency sweep."""
         amp, freq = np.meshgrid(self.amplitude, self.frequency_hz, indexing="ij")
         k = self.stiffness.ravel()
         return {
@@ -319,7 +319,7 @@ class LoopResult:
 
 
 def steady_friction_loop(strain_amplitude: float, phase, friction_stress_max, friction_strain_half):
-    """Steady Berg friction stress along ε = ε̂ sin θ, in closed form (MODEL.md, route 2).
+    """Steady Berg friction stress along ε = ε̂ sin θ, in closed form (docs/model.md, route 2).
 
     Rising branch (cos θ ≥ 0): σ = σ_fmax [1 − ε½ (1 + x)² / (ε½ (1 + x) + ε̂ + ε)];
     falling branch: σ(ε) = −σ_rising(−ε); x from :func:`core.material.friction_reversal_ratio`.

@@ -1,4 +1,4 @@
-"""The ``bushing`` command line (FORMATS.md): a thin shell over the core.
+"""The ``bushing`` command line (docs/files.md): a thin shell over the core.
 
 Bad input exits with status 2 and one readable line on standard error; a computation that
 cannot converge exits with status 1 and one line; no traceback is ever printed.
@@ -56,6 +56,11 @@ def _count(name, minimum=1):
     return parse
 
 
+def subcommands(parser: argparse.ArgumentParser):
+    """The sub-parser action of :func:`build_parser`'s parser (to add commands to)."""
+    return next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="bushing",
@@ -71,7 +76,7 @@ def build_parser() -> argparse.ArgumentParser:
         "amplitude, stiffness_real, stiffness_imag, magnitude, loss_factor (one row per "
         "amplitude and frequency; N/m axially, N·m/rad in torsion).",
     )
-    st.add_argument("design", metavar="DESIGN.json", help="design file (FORMATS.md)")
+    st.add_argument("design", metavar="DESIGN.json", help="design file (docs/files.md)")
     st.add_argument(
         "--freq",
         nargs=3,
@@ -114,7 +119,7 @@ def build_parser() -> argparse.ArgumentParser:
         "Writes CSV with columns displacement, force, force_elastic, force_viscoelastic, "
         "force_friction (m or rad; N or N·m).",
     )
-    lp.add_argument("design", metavar="DESIGN.json", help="design file (FORMATS.md)")
+    lp.add_argument("design", metavar="DESIGN.json", help="design file (docs/files.md)")
     lp.add_argument("--freq", required=True, type=_positive("--freq"), metavar="F", help="Hz")
     lp.add_argument(
         "--amp", required=True, type=_positive("--amp"), metavar="A", help="peak, m or rad"
@@ -152,22 +157,12 @@ def build_parser() -> argparse.ArgumentParser:
     dg.add_argument("--predictions", metavar="PRED.csv",
                     help="write, per data row, the baseline's and the final model's |K| and loss factor")
 
-    sv = sub.add_parser(
-        "serve",
-        help="start the explorer in the browser (embedded defaults, no setup)",
-        description="Start the Bushing Explorer web app and print its URL.",
-    )
-    sv.add_argument("--port", type=_count("--port", 0), default=5006, metavar="P", help="default 5006")
-    sv.add_argument(
-        "--address", default="localhost", metavar="A",
-        help="interface to listen on (default localhost; 0.0.0.0 for every interface)",
-    )
     return parser
 
 
 def _measured_arguments(parser: argparse.ArgumentParser, design_help: str) -> None:
     """MEASURED.csv --design DESIGN.json: what `fit` and `diagnose` both take."""
-    parser.add_argument("measured", metavar="MEASURED.csv", help="measured stiffness (FORMATS.md)")
+    parser.add_argument("measured", metavar="MEASURED.csv", help="measured stiffness (docs/files.md)")
     parser.add_argument("--design", required=True, metavar="DESIGN.json", help=design_help)
 
 
@@ -270,25 +265,16 @@ def _cmd_diagnose(args) -> None:
         sys.stdout.write(summary(result))
 
 
-def _cmd_serve(args) -> None:
-    if args.port > 65535:
-        raise InputError(f"bushing serve: --port must be at most 65535, got {args.port}")
-    from app.main import serve  # the browser app: imported only when asked for
-
-    try:
-        serve(port=args.port, address=args.address)
-    except OSError as exc:
-        raise InputError(f"bushing serve: cannot listen on {args.address}:{args.port}: {exc.strerror}")
+COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop, "fit": _cmd_fit, "diagnose": _cmd_diagnose}
 
 
-COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop, "fit": _cmd_fit, "diagnose": _cmd_diagnose,
-            "serve": _cmd_serve}
-
-
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, parser: argparse.ArgumentParser | None = None,
+         commands: dict | None = None) -> int:
+    """Run one command. ``parser`` and ``commands`` extend the core's (``app.cli`` adds ``serve``:
+    the command line's core knows nothing of the browser app)."""
     with _one_line_errors():
-        args = build_parser().parse_args(argv)
-        COMMANDS[args.command](args)
+        args = (parser or build_parser()).parse_args(argv)
+        (commands or COMMANDS)[args.command](args)
     return 0
 
 

@@ -1,4 +1,4 @@
-"""Measured data (FORMATS.md): dynamic-stiffness tables and hysteresis loops, read strictly.
+"""Measured data (docs/files.md): dynamic-stiffness tables and hysteresis loops, read strictly.
 
 Every refusal names the line (the header is line 1) and the reason; no row is ever dropped
 silently. All numbers are SI: Hz, m or rad, N/m or N·m/rad, s, N or N·m.
@@ -30,7 +30,7 @@ class DataError(ValueError):
 
 
 def loss_factor(k) -> np.ndarray:
-    """η = Im K / Re K of complex stiffness (MODEL.md)."""
+    """η = Im K / Re K of complex stiffness (docs/model.md)."""
     k = np.asarray(k)
     return k.imag / k.real
 
@@ -107,7 +107,7 @@ class MeasuredLoop:
     force: np.ndarray
 
     def to_csv(self, path: str | Path | None = None) -> str:
-        """The loop file of FORMATS.md: time_s, displacement, force."""
+        """The loop file of docs/files.md: time_s, displacement, force."""
         cols = {"time_s": self.time_s, "displacement": self.displacement, "force": self.force}
         return _written(csv_text(cols, FILE_NUMBER_FORMAT), path)
 

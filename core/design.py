@@ -1,6 +1,6 @@
 """Bushing designs: validated, immutable geometry, material and mode, and the design file.
 
-Symbols (MODEL.md), their names here and units:
+Symbols (docs/model.md), their names here and units:
 
 ====== ========================== ========= =========================================
 symbol name                       unit      meaning
@@ -115,7 +115,7 @@ def _frozen_effects(effects: Mapping[str, Mapping[str, float]]) -> tuple:
 class Design:
     """A bushing: mode (``axial`` or ``torsion``), geometry and material, optionally named.
 
-    ``effects`` holds the model extensions of the discrepancy workflow (MODEL.md's table,
+    ``effects`` holds the model extensions of the discrepancy workflow (docs/model.md's table,
     :mod:`core.effects`); pass a mapping ``{effect_id: {parameter: value}}``: it is validated
     and frozen into a hashable tuple.
     """
@@ -154,7 +154,7 @@ class Design:
         return Design(**current)
 
     def to_dict(self) -> dict:
-        """The design-file object of FORMATS.md."""
+        """The design-file object of docs/files.md."""
         out: dict[str, Any] = {}
         if self.name is not None:
             out["name"] = self.name
@@ -190,7 +190,7 @@ def _exact_keys(where: str, obj: Any, allowed: tuple[str, ...], required: tuple[
 
 
 def design_from_dict(data: Any) -> Design:
-    """Build a :class:`Design` from a design-file object (FORMATS.md), refusing anything off."""
+    """Build a :class:`Design` from a design-file object (docs/files.md), refusing anything off."""
     _exact_keys("", data, _TOP_KEYS, ("mode", "geometry", "material"))
     _exact_keys("geometry", data["geometry"], _GEOMETRY_KEYS, _GEOMETRY_KEYS)
     _exact_keys("material", data["material"], _MATERIAL_KEYS, _MATERIAL_KEYS)
@@ -237,7 +237,7 @@ def write_design(design: Design, path: str | Path) -> None:
     Path(path).write_text(dumps_design(design), encoding="utf-8")
 
 
-# Reference designs of the thesis (MODEL.md, "Reference data").
+# Reference designs of the thesis (docs/model.md, "Reference data").
 PAPER_B = Design(
     name="VP 40/70120 (Paper B)",
     mode="axial",

@@ -1,4 +1,4 @@
-"""The discrepancy workflow (issue 5): where model and measurement disagree, which effect of the
+"""The discrepancy workflow: where model and measurement disagree, which effect of the
 library is missing, and the gap shrinking as it is added.
 
 1. Fit the baseline (the design's geometry is known; the parameters of its branches and of any
@@ -392,7 +392,7 @@ class Diagnosis:
         return None if self.noise_variance is None else math.sqrt(self.noise_variance)
 
     def report(self) -> dict:
-        """The report of FORMATS.md's ``bushing diagnose``."""
+        """The report of docs/files.md's ``bushing diagnose``."""
         out = {
             "baseline": list(self.baseline.model.branches),
             "added": self.added,

@@ -1,6 +1,6 @@
-"""Effects the thesis model leaves out: named, parameterised extensions (MODEL.md's table).
+"""Effects the thesis model leaves out: named, parameterised extensions (docs/model.md's table).
 
-Each effect is a small record: its id (as in MODEL.md and the design file's ``effects``
+Each effect is a small record: its id (as in docs/model.md and the design file's ``effects``
 object), a title, its parameters with units, the physics in plain words and the signature it
 leaves in measured stiffness. How an effect enters the model is in one of three places:
 
@@ -222,7 +222,7 @@ def inertia_correction(stiffness, frequency_hz, mass: float):
 
 
 def wave_stiffness(mode: str, inner_radius, outer_radius, length, modulus, frequency_hz, density):
-    """Stiffness with standing shear waves in the rubber (MODEL.md, ``wave_effects``).
+    """Stiffness with standing shear waves in the rubber (docs/model.md, ``wave_effects``).
 
     Axial: w'' + w'/r + k² w = 0, k² = ρω²/µ_eq, w(a) = 0, w(b) = d, so
     w = A J0(kr) + B Y0(kr) and K = 2π a L µ_eq w'(a) / d.

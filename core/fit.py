@@ -1,10 +1,10 @@
-"""Identification of the five material parameters from measured data (issue 4).
+"""Identification of the five material parameters from measured data.
 
 Two procedures:
 
 * :func:`fit_global`: all five parameters to all data at once. The misfit is the complex
   relative error of stiffness, (K_model − K_data)/|K_data| (real and imaginary parts), the same
-  quantity as the gap of FORMATS.md, plus, when a measured loop is given, the loop force error
+  quantity as the gap of docs/files.md, plus, when a measured loop is given, the loop force error
   relative to its RMS, weighted so that the loop counts as much as the stiffness points.
   Parameters are fitted as ln µ, ln m, α, ln σ_fmax, ln ε½ (positive by construction; α bounded
   to (0, 1]); bounded least squares (trust-region reflective) from several starting points, and
@@ -87,7 +87,7 @@ def relative_residual(model: np.ndarray, data: np.ndarray) -> np.ndarray:
 
 
 def gap(model: np.ndarray, data: np.ndarray) -> float:
-    """FORMATS.md's gap: sqrt(mean(|K_model − K_data|² / |K_data|²))."""
+    """docs/files.md's gap: sqrt(mean(|K_model − K_data|² / |K_data|²))."""
     return float(np.sqrt(np.mean(np.abs(relative_residual(model, data)) ** 2)))
 
 
@@ -107,7 +107,7 @@ class FitResult:
     history: list = field(default_factory=list)
 
     def report(self) -> dict:
-        """The ``fit`` object of the fitted design file (FORMATS.md)."""
+        """The ``fit`` object of the fitted design file (docs/files.md)."""
         out = {
             "standard_errors": self.standard_errors,
             "correlation": self.correlation,
@@ -124,7 +124,7 @@ class FitResult:
         return {**self.design.to_dict(), "fit": self.report()}
 
     def to_json(self) -> str:
-        """The fitted design file (FORMATS.md): the design and its ``fit`` object."""
+        """The fitted design file (docs/files.md): the design and its ``fit`` object."""
         return json.dumps(self.to_dict(), indent=2) + "\n"
 
 
@@ -235,11 +235,18 @@ def _solve(problem: _Problem, starts: list[np.ndarray]):
     return best
 
 
+def fitted_name(name: str | None) -> str | None:
+    """The name of a fitted design: "(fitted)" added once, however often a design is refitted."""
+    if not name or name.endswith(" (fitted)"):
+        return name
+    return f"{name} (fitted)"
+
+
 def _result(problem: _Problem, sol, method: str, starts: int, design: Design, errors=None, corr=None):
     if errors is None:
         errors, corr = _uncertainties(problem, sol)
     fitted = problem.model(sol.x)
-    fitted = fitted.replace(name=design.name and f"{design.name} (fitted)")
+    fitted = fitted.replace(name=fitted_name(design.name))
     g = float("nan")
     if problem.data is not None:
         g = gap(stiffness_points(fitted, problem.data.frequency_hz, problem.data.amplitude),

@@ -32,7 +32,7 @@ REFERENCE_FREQUENCY_HZ = 10.0  # rate_amplitude_coupling: µ_f · (f / 10 Hz)^γ
 def friction_reversal_ratio(z):
     """Steady turning-point friction stress in units of σ_fmax, for amplitude z = ε̂/ε½.
 
-    x solves x² + (1 + z) x − z = 0 (MODEL.md); written without cancellation as
+    x solves x² + (1 + z) x − z = 0 (docs/model.md); written without cancellation as
     x = 2z / ((1 + z) + sqrt((1 + z)² + 4z)).
     """
     z = np.asarray(z, dtype=float)
@@ -57,7 +57,7 @@ def _log1p_remainder(q):
 
 
 def friction_modulus_universal(z):
-    """Universal friction modulus g(z), with µ_f(ε̂) = (σ_fmax/ε½) · g(ε̂/ε½) (MODEL.md).
+    """Universal friction modulus g(z), with µ_f(ε̂) = (σ_fmax/ε½) · g(ε̂/ε½) (docs/model.md).
 
     The steady symmetric Berg loop between ±ε̂ has the rising branch (ε in units of ε½,
     σ in units of σ_fmax)  σ = 1 − (1 + x)² / ((1 + x) + z + ε), and the falling branch by
@@ -85,7 +85,7 @@ def friction_modulus_universal(z):
 
 
 def friction_modulus(strain_amplitude, friction_stress_max: float, friction_strain_half: float):
-    """Friction modulus µ_f(ε̂) in Pa for the tensor strain amplitude ε̂ (MODEL.md, route 2)."""
+    """Friction modulus µ_f(ε̂) in Pa for the tensor strain amplitude ε̂ (docs/model.md, route 2)."""
     eps = np.asarray(strain_amplitude, dtype=float)
     return friction_stress_max / friction_strain_half * friction_modulus_universal(
         eps / friction_strain_half
@@ -203,7 +203,7 @@ def branch_stresses(
 ) -> BranchStresses:
     """Stress of each branch for the sampled strain history ``strain`` (step ``dt`` in s).
 
-    ``effects`` (id → parameters, MODEL.md) adds the material-level extensions in the time
+    ``effects`` (id → parameters, docs/model.md) adds the material-level extensions in the time
     domain: σ_el = 2µε(1 + βε²) (``strain_stiffening``), σ += c dε/dt (``viscous``, central
     differences), σ_f · (f / 10 Hz)^γ (``rate_amplitude_coupling``, which needs the drive
     frequency ``frequency_hz``: it is defined for harmonic drives only).

@@ -273,7 +273,7 @@ def test_other_tabs_are_built_when_opened_and_catch_up_when_shown(app):
     assert np.all(fresh > stale)
 
 
-# ---- measured data and fitting (issue 4) ---------------------------------------------------
+# ---- measured data and fitting ------------------------------------------------------------
 
 
 def example_files():

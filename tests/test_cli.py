@@ -1,4 +1,4 @@
-"""The `bushing` command line exactly as FORMATS.md describes it."""
+"""The `bushing` command line exactly as docs/files.md describes it."""
 
 import csv
 import io
@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from app.cli import main  # the `bushing` entry point
 from core import PAPER_B, TABLE_1, loop, stiffness, write_design
-from core.cli import main
 from tests.helpers import free_port, wait_for
 
 STIFFNESS_COLUMNS = ["frequency_hz", "amplitude", "stiffness_real", "stiffness_imag", "magnitude", "loss_factor"]
@@ -157,7 +157,7 @@ def test_installed_entry_point_runs_without_traceback(designs, tmp_path):
 
 def test_serve_prints_its_url_and_answers():
     port = free_port()
-    proc = subprocess.Popen([sys.executable, "-m", "core.cli", "serve", "--port", str(port)],
+    proc = subprocess.Popen([sys.executable, "-m", "app.cli", "serve", "--port", str(port)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         line = proc.stdout.readline()

@@ -1,4 +1,4 @@
-"""The discrepancy workflow (issue 5): effects hidden in synthetic data with 0.5 % noise; the
+"""The discrepancy workflow: effects hidden in synthetic data with 0.5 % noise; the
 workflow is not told which. The noise fixes the floor: complex relative noise with 0.5 % in each
 part gives a gap of sqrt(2) · 0.005 ≈ 0.0071."""
 

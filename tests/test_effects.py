@@ -1,4 +1,4 @@
-"""Model extensions (MODEL.md's table of effects) against independent routes."""
+"""Model extensions (docs/model.md's table of effects) against independent routes."""
 
 import numpy as np
 import pytest

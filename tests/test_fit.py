@@ -137,3 +137,15 @@ def test_fit_report_is_the_design_file_plus_fit(tmp_path):
     assert report["gap"] == pytest.approx(r.gap)
     # the fitted model reproduces the grid computation
     assert_allclose(stiffness_points(r.design, 10.0, 1e-4), stiffness(r.design, 10.0, 1e-4).stiffness[0, 0])
+
+
+def test_a_refitted_design_is_named_fitted_once():
+    from core.diagnose import diagnose
+    from core.fit import fitted_name
+    from core.synthetic import synthetic_stiffness
+
+    assert fitted_name("VP") == "VP (fitted)" == fitted_name("VP (fitted)")
+    assert fitted_name(None) is None
+    data = synthetic_stiffness(PAPER_B, np.linspace(1, 100, 10), [1e-5, 1e-4, 1e-3], seed=1)
+    report = diagnose(PAPER_B, data, held_out=False).report()
+    assert report["design"]["name"] == f"{PAPER_B.name} (fitted)"

@@ -1,4 +1,4 @@
-"""The material model: both routes, the limits and identities of MODEL.md, the branches."""
+"""The material model: both routes, the limits and identities of docs/model.md, the branches."""
 
 import numpy as np
 import pytest
@@ -29,7 +29,7 @@ PAPER_B_FREQUENCIES = [1.0, 3.0, 10.0, 30.0, 100.0]
 
 @pytest.mark.parametrize("amplitude", PAPER_B_AMPLITUDES_M)
 def test_routes_agree_on_paper_b(amplitude):
-    """MODEL.md: analytic and time-domain routes agree to better than 1e-3 (we hold 1e-4)."""
+    """docs/model.md: analytic and time-domain routes agree to better than 1e-3 (we hold 1e-4)."""
     eps = strain_factor(PAPER_B.geometry, "axial") * amplitude
     for f in PAPER_B_FREQUENCIES:
         td = equivalent_modulus_time_domain(PAPER_B.material, f, eps)
@@ -100,7 +100,7 @@ def test_large_amplitude_is_the_coulomb_square_loop():
 @settings(max_examples=60, deadline=None)
 @given(st.floats(1e-6, 1e5))
 def test_loop_area_is_dissipated_energy(z):
-    """Area of the steady loop ∮σ dε = 2π ε̂² Im µ_f (MODEL.md), by trapezoids on the loop."""
+    """Area of the steady loop ∮σ dε = 2π ε̂² Im µ_f (docs/model.md), by trapezoids on the loop."""
     theta = np.linspace(0, 2 * np.pi, 200001)
     sig = steady_friction_loop(z, theta, 1.0, 1.0)
     area = -np.trapezoid(z * np.sin(theta), sig)  # ∮ σ dε = −∮ ε dσ
