@@ -14,7 +14,7 @@ import numpy as np
 
 from core import Design
 from core.bushing import branch_stiffness, loop, material_model, stiffness, strain_factor
-from core.data import MeasuredLoop, MeasuredStiffness, loss_factor
+from core.data import MeasuredLoop, MeasuredStiffness, loss_factor, magnitude_residual_pct
 from core.material import ConvergenceError
 
 from . import units
@@ -243,7 +243,7 @@ def misfit_points(r, which: str) -> dict:
     return {
         "frequency_hz": d.frequency_hz,
         "amplitude": units.display_amplitude(d.amplitude, r.final.design.mode),
-        "magnitude_pct": 100 * (np.abs(k) / d.magnitude - 1),
+        "magnitude_pct": magnitude_residual_pct(k, d.stiffness),
         "loss_factor": loss_factor(k) - d.loss_factor,
     }
 

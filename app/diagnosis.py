@@ -175,7 +175,9 @@ class DiagnosisView(pn.viewable.Viewer):
             f"*Where it disagrees:* {r.where_baseline}",
         ]
         for n, step in enumerate(r.steps, 1):
-            params = ", ".join(f"{k} = {v:.4g}" for k, v in step.parameters.items()) or "no parameters"
+            params = ", ".join(f"{k} = {v:.4g}" + (f" ± {step.standard_errors[k]:.2g}"
+                                                   if np.isfinite(step.standard_errors.get(k, np.nan)) else "")
+                               for k, v in step.parameters.items()) or "no parameters"
             partner = step.extra.get("found_with")
             together = f" (found together with {partner})" if partner else ""
             lines.append(f"**Step {n}: add {EFFECTS[step.effect].title}**{together}: {params}. Evidence: BIC "

@@ -33,7 +33,7 @@ import numpy as np
 from bokeh.models import SaveTool
 
 from core import Design
-from core.data import MeasuredStiffness
+from core.data import MeasuredStiffness, loss_factor, magnitude_residual_pct
 
 from . import curves, units
 
@@ -391,10 +391,9 @@ def residual_overlays(points: dict | None, residuals: dict | None, dims: dict) -
 def residual_plots(design: Design, measured: MeasuredStiffness, *, width: int | None = 500) -> hv.Layout:
     """The residuals of ``design`` against measured stiffness."""
     from core.bushing import stiffness_points
-    from core.data import loss_factor
 
     k = stiffness_points(design, measured.frequency_hz, measured.amplitude)
-    residuals = {"magnitude_residual_pct": 100 * (np.abs(k) / measured.magnitude - 1),
+    residuals = {"magnitude_residual_pct": magnitude_residual_pct(k, measured.stiffness),
                  "loss_factor_residual": loss_factor(k) - measured.loss_factor}
     overlays = residual_overlays(curves.measured_points(measured, design.mode), residuals, dimensions(design.mode))
     return sized(hv.Layout(list(overlays.values())).cols(2), width)

@@ -20,6 +20,7 @@ from core.data import (
     MeasuredLoop,
     MeasuredStiffness,
     loss_factor,
+    magnitude_residual_pct,
     parse_loop,
     parse_stiffness,
 )
@@ -295,7 +296,7 @@ class ExplorerState(param.Parameterized):
             return None
         k_model = stiffness_points(self.design, d.frequency_hz, d.amplitude)
         return {
-            "magnitude_residual_pct": 100 * (np.abs(k_model) / d.magnitude - 1),
+            "magnitude_residual_pct": magnitude_residual_pct(k_model, d.stiffness),
             "loss_factor_residual": loss_factor(k_model) - d.loss_factor,
             "gap": gap(k_model, d.stiffness),
         }

@@ -24,8 +24,7 @@ import numpy as np
 from . import material as mat
 from .data import ComplexStiffness, loss_factor
 from .design import Design, Geometry
-from .effects import extended_modulus, inertia_correction, wave_stiffness
-from .material import REFERENCE_FREQUENCY_HZ
+from .effects import EFFECTS, branch_moduli, extended_modulus, inertia_correction, wave_stiffness
 from .slices import continuum_nodes, slice_nodes, solve_series
 
 UNITS = {
@@ -134,18 +133,14 @@ def _time_domain_point(material, effects: tuple, frequency_hz: float, strain_amp
     ).modulus
 
 
-_MATERIAL_EFFECTS = ("viscous", "strain_stiffening", "rate_amplitude_coupling")
-
-
 def modulus_function(design: Design, route: str = "analytic"):
     """µ_eq(frequency_hz, strain_amplitude) of the design's material with its material-level
     effects, by the chosen route, broadcast over both arguments."""
     if route == "analytic":
-        base = functools.partial(mat.equivalent_modulus, design.material)
         effects = design.effect_parameters
-        if any(e in effects for e in _MATERIAL_EFFECTS):
-            return functools.partial(extended_modulus, design.material, effects, base_modulus=base)
-        return base
+        if any(EFFECTS[e].term is not None for e in effects):
+            return functools.partial(extended_modulus, design.material, effects)
+        return functools.partial(mat.equivalent_modulus, design.material)
     if route == "time-domain":
         # the time-domain route simulates the material-level effects itself
         return functools.partial(_modulus_time_domain, design.material, design.effects)
@@ -256,22 +251,10 @@ def branch_stiffness(design: Design, frequency_hz, amplitude) -> dict[str, np.nd
     _refuse_structural_effects(design, "the branch-by-branch stiffness")
     f = _grid("frequency_hz", frequency_hz)[None, :]
     x = _grid("amplitude", amplitude)[:, None]
-    m = design.material
-    effects = design.effect_parameters
     s = shape_factor(design.geometry, design.mode)
     eps = strain_factor(design.geometry, design.mode) * x
-    zeros = np.zeros(np.broadcast_shapes(f.shape, x.shape))
-    elastic = s * m.shear_modulus * (
-        1.0 + 0.75 * effects.get("strain_stiffening", {}).get("stiffening", 0.0) * eps**2
-    ) + zeros
-    visco = s * (
-        mat.fractional_modulus(f, m.fractional_coefficient, m.fractional_order)
-        + 1j * np.pi * f * effects.get("viscous", {}).get("viscosity", 0.0)
-    ) + zeros
-    friction = s * mat.friction_modulus(eps, m.friction_stress_max, m.friction_strain_half) * (
-        f / REFERENCE_FREQUENCY_HZ
-    ) ** effects.get("rate_amplitude_coupling", {}).get("rate_exponent", 0.0) + zeros
-    return {"elastic": elastic + 0j, "viscoelastic": visco, "friction": friction + 0j}
+    return {name: s * modulus for name, modulus in
+            branch_moduli(design.material, design.effect_parameters, f, eps).items()}
 
 
 def cache_info():
@@ -369,8 +352,12 @@ def loop(
 
 def loop_force(design: Design, frequency_hz: float, amplitude: float, phase):
     """Steady force (moment) branches at the drive phases θ, x = x̂ sin θ, in closed form:
-    (elastic, viscoelastic, friction), each in N or N·m. Elastic 2µε(1 + βε²); viscoelastic
-    Im((m(iω)^α + iωc) ε̂ e^{iθ}); friction the steady Berg loop (× (f/10 Hz)^γ)."""
+    (elastic, viscoelastic, friction), each in N or N·m. The viscoelastic branch is linear:
+    Im(2 µ_ve ε̂ e^{iθ}) with its branch modulus µ_ve (:func:`core.effects.branch_moduli`: the
+    fractional term and any viscous one). The friction branch is the steady Berg loop scaled as
+    its branch modulus is by the effects (µ_f → µ_f (f/10 Hz)^γ). The elastic branch is the
+    waveform 2µε(1 + βε²) with strain stiffening (its first harmonic is the elastic branch
+    modulus µ(1 + ¾βε̂²); the third harmonic the closed form leaves out is drawn here)."""
     m = design.material
     effects = design.effect_parameters
     c = strain_factor(design.geometry, design.mode)
@@ -378,15 +365,12 @@ def loop_force(design: Design, frequency_hz: float, amplitude: float, phase):
     eps_amp = c * amplitude
     theta = np.asarray(phase, dtype=float)
     eps = eps_amp * np.sin(theta)
-    el = 2.0 * m.shear_modulus * eps
-    if "strain_stiffening" in effects:
-        el = el * (1.0 + effects["strain_stiffening"]["stiffening"] * eps**2)
-    visco_amp = m.fractional_coefficient * (2j * np.pi * frequency_hz) ** m.fractional_order
-    visco_amp += 2j * np.pi * frequency_hz * effects.get("viscous", {}).get("viscosity", 0.0)
-    fr = np.imag(visco_amp * eps_amp * np.exp(1j * theta))
+    moduli = branch_moduli(m, effects, frequency_hz, eps_amp)
+    el = 2.0 * m.shear_modulus * eps * (1.0 + effects.get("strain_stiffening", {}).get("stiffening", 0.0) * eps**2)
+    fr = np.imag(2.0 * complex(moduli["viscoelastic"]) * eps_amp * np.exp(1j * theta))
     fric = steady_friction_loop(eps_amp, theta, m.friction_stress_max, m.friction_strain_half)
-    if "rate_amplitude_coupling" in effects:
-        fric = fric * (frequency_hz / REFERENCE_FREQUENCY_HZ) ** effects["rate_amplitude_coupling"]["rate_exponent"]
+    base_friction = mat.friction_modulus(eps_amp, m.friction_stress_max, m.friction_strain_half)
+    fric = fric * (complex(moduli["friction"]) / complex(base_friction)).real
     return scale * el, scale * fr, scale * fric
 
 

@@ -29,6 +29,11 @@ class DataError(ValueError):
     """A measured-data file breaks a rule; the message names the line and the reason."""
 
 
+def magnitude_residual_pct(k_model, k_data) -> np.ndarray:
+    """|K| of a model against data, in % of the data's: 100 (|K_model| / |K_data| − 1)."""
+    return 100.0 * (np.abs(k_model) / np.abs(k_data) - 1.0)
+
+
 def loss_factor(k) -> np.ndarray:
     """η = Im K / Re K of complex stiffness (docs/model.md)."""
     k = np.asarray(k)

@@ -16,7 +16,7 @@ leaves in measured stiffness. How an effect enters the model is in one of three 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -24,7 +24,7 @@ import numpy as np
 from scipy import special
 
 from .design import DesignError, Material
-from .material import REFERENCE_FREQUENCY_HZ, friction_modulus
+from .material import REFERENCE_FREQUENCY_HZ, fractional_modulus, friction_modulus
 
 
 @dataclass(frozen=True)
@@ -46,6 +46,27 @@ class Effect:
     branch: bool = False  # one of the thesis' own branches (parameters live in `material`)
     requires: tuple[str, ...] = ()  # acts only on one of these (branches or effects)
     excludes: tuple[str, ...] = ()  # cannot be combined with these effects
+    # a material-level effect's frequency-domain term: (material, its parameters, f in Hz, ε̂)
+    # → (the branch it enters, what it adds to that branch's modulus µ_eq, in Pa). The one
+    # source of the effect's physics for the closed-form route: the equivalent modulus, the
+    # branch-by-branch stiffness and the loop's branch amplitudes are derived from it.
+    term: Callable[..., tuple[str, Any]] | None = None
+
+
+def _stiffening_term(material, p, f, eps):
+    """σ_el = 2µε(1 + βε²): its first harmonic at ε = ε̂ sin ωt is 2µ(1 + ¾βε̂²) ε̂."""
+    return "elastic", material.shear_modulus * 0.75 * p["stiffening"] * eps**2
+
+
+def _viscous_term(_material, p, f, _eps):
+    """σ = c dε/dt: µ_eq += iωc / 2."""
+    return "viscoelastic", 1j * np.pi * f * p["viscosity"]
+
+
+def _rate_term(material, p, f, eps):
+    """µ_f(ε̂) (f / 10 Hz)^γ in place of µ_f(ε̂)."""
+    mu_f = friction_modulus(eps, material.friction_stress_max, material.friction_strain_half)
+    return "friction", mu_f * ((f / REFERENCE_FREQUENCY_HZ) ** p["rate_exponent"] - 1.0)
 
 
 EFFECTS: dict[str, Effect] = {
@@ -95,6 +116,7 @@ EFFECTS: dict[str, Effect] = {
             "fast relaxation mechanism.",
             "The loss factor grows in proportion to frequency at every amplitude, more than "
             "the fractional branch allows.",
+            term=_viscous_term,
         ),
         Effect(
             "strain_stiffening",
@@ -103,6 +125,7 @@ EFFECTS: dict[str, Effect] = {
             "The rubber network stiffens as its chains approach their full extension.",
             "At the largest amplitudes the stiffness is higher than the model, growing with "
             "the amplitude squared, at every frequency; the loss factor drops there.",
+            term=_stiffening_term,
         ),
         Effect(
             "rate_amplitude_coupling",
@@ -114,6 +137,7 @@ EFFECTS: dict[str, Effect] = {
             "The amplitude dependence is stronger at high frequency than at low: the gap "
             "between small- and large-amplitude stiffness grows with frequency.",
             requires=("friction",),
+            term=_rate_term,
         ),
         Effect(
             "nonuniform_strain",
@@ -185,29 +209,34 @@ def validate_effects(effects: Any) -> dict[str, dict[str, float]]:
 # --------------------------------------------------------------------------------------------
 
 
-def extended_modulus(material: Material, effects: Mapping, frequency_hz, strain_amplitude,
-                     base_modulus):
-    """µ_eq with the material-level effects, broadcast over frequency and strain amplitude:
+BRANCH_NAMES = ("elastic", "viscoelastic", "friction")
 
-    µ_eq = µ (1 + ¾ β ε̂²) + m (iω)^α / 2 + i ω c / 2 + µ_f(ε̂) (f / 10 Hz)^γ
 
-    (``strain_stiffening`` β: the first harmonic of 2µε(1 + βε²); ``viscous`` c;
-    ``rate_amplitude_coupling`` γ). ``base_modulus(frequency_hz, strain_amplitude)`` gives the
-    thesis' own µ + m(iω)^α/2 + µ_f, whose parts are then corrected.
-    """
+def branch_moduli(material: Material, effects: Mapping, frequency_hz, strain_amplitude) -> dict:
+    """µ_eq(ω, ε̂) split by branch, broadcast over frequency and strain amplitude, in Pa:
+    ``elastic`` µ, ``viscoelastic`` m (iω)^α / 2, ``friction`` µ_f(ε̂) (eq 16 by the closed-form
+    route), each with the terms of the material-level effects that enter it (:attr:`Effect.term`)."""
     f = np.asarray(frequency_hz, dtype=float)
     eps = np.asarray(strain_amplitude, dtype=float)
-    mu = base_modulus(f, eps)
-    if "strain_stiffening" in effects:
-        beta = effects["strain_stiffening"]["stiffening"]
-        mu = mu + material.shear_modulus * 0.75 * beta * eps**2
-    if "viscous" in effects:
-        mu = mu + 1j * np.pi * f * effects["viscous"]["viscosity"]  # iωc/2
-    if "rate_amplitude_coupling" in effects:
-        gamma = effects["rate_amplitude_coupling"]["rate_exponent"]
-        mu_f = friction_modulus(eps, material.friction_stress_max, material.friction_strain_half)
-        mu = mu + mu_f * ((f / REFERENCE_FREQUENCY_HZ) ** gamma - 1.0)
-    return mu
+    zeros = np.zeros(np.broadcast_shapes(f.shape, eps.shape), dtype=complex)
+    out = {
+        "elastic": material.shear_modulus + zeros,
+        "viscoelastic": fractional_modulus(f, material.fractional_coefficient, material.fractional_order) + zeros,
+        "friction": friction_modulus(eps, material.friction_stress_max, material.friction_strain_half) + zeros,
+    }
+    for eid, params in effects.items():
+        term = EFFECTS[eid].term
+        if term is not None:
+            branch, value = term(material, params, f, eps)
+            out[branch] = out[branch] + value
+    return out
+
+
+def extended_modulus(material: Material, effects: Mapping, frequency_hz, strain_amplitude):
+    """µ_eq with the material-level effects, broadcast over frequency and strain amplitude: the
+    sum of :func:`branch_moduli`, µ (1 + ¾ β ε̂²) + m (iω)^α / 2 + i ω c / 2 + µ_f(ε̂) (f / 10 Hz)^γ."""
+    parts = branch_moduli(material, effects, frequency_hz, strain_amplitude)
+    return parts["elastic"] + parts["viscoelastic"] + parts["friction"]
 
 
 # --------------------------------------------------------------------------------------------

@@ -11,7 +11,7 @@ from numpy.testing import assert_allclose
 
 from app.main import App, create_app
 from app.state import ExplorerState
-from core import PAPER_B, TABLE_1, loads_design, loop, stiffness, stiffness_points
+from core import PAPER_B, TABLE_1, loads_design, loop, stiffness
 from tests.helpers import element, figures, marker_at, rendered, xy
 
 
@@ -293,12 +293,23 @@ def test_measured_points_appear_over_the_model(app):
     points = app.state.measured_points()
     assert_allclose(y, points["magnitude"])
     assert_allclose(x, points["frequency_hz"])
-    k_model = stiffness_points(app.state.design, points["frequency_hz"], points["amplitude"] * 1e-3)
+    app.tabs.active = 3  # the residual plots hold the state's numbers
     residuals = app.state.measured_residuals()
-    assert_allclose(residuals["magnitude_residual_pct"], 100 * (np.abs(k_model) / app.state.measured.magnitude - 1))
-    app.tabs.active = 3  # the residual plots hold the same numbers
     assert_allclose(xy(app.measured.frame("magnitude", "frequency"), "residual")[1],
                     residuals["magnitude_residual_pct"])
+    # exact data of a bushing 10 % longer (K ∝ L, the loss factor unchanged): the explorer's
+    # design is 1/1.1 − 1 = −9.09 % off at every point, with no loss-factor residual
+    from core.synthetic import synthetic_stiffness
+
+    app.inputs.widgets["shear_modulus_mpa"].value = 2.42
+    longer = synthetic_stiffness(PAPER_B.replace(geometry=PAPER_B.geometry.__class__(0.020, 0.035, 0.099)),
+                                 np.linspace(1, 100, 7), [1e-5, 1e-4, 1e-3], noise=0.0)
+    assert app.state.load_measured(longer.to_csv(), "longer.csv")
+    residuals = app.state.measured_residuals()
+    assert_allclose(residuals["magnitude_residual_pct"], 100 * (1 / 1.1 - 1), rtol=1e-8)
+    assert_allclose(residuals["loss_factor_residual"], 0.0, atol=1e-9)
+    assert residuals["gap"] == pytest.approx(1 / 11, rel=1e-6)  # |K_model − K_data| / |K_data| = 1 − 1/1.1
+    assert_allclose(xy(app.measured.frame("magnitude", "amplitude"), "residual")[1], 100 * (1 / 1.1 - 1), rtol=1e-8)
     app.tabs.active = 0
     assert app.state.load_measured_loop(loop_bytes, "l.csv")
     assert app.state.frequency_hz == pytest.approx(0.1) and app.state.amplitude == pytest.approx(1.0)

@@ -50,6 +50,7 @@ def test_a_diagnosis_in_the_tab_holds_the_core_numbers(app):
     r = state.result
     assert r.added == ["inertia"] and state.message == "" and not state.running
     assert "Step 1: add Apparent mass seen by the force sensor" in view.report.object
+    assert f"mass = {r.steps[0].parameters['mass']:.4g} ± {r.steps[0].standard_errors['mass']:.2g}" in view.report.object
     assert "What is left is noise" in view.report.object
     # the gap bars: the baseline's and after each step; the noise line
     gap = view.gap.current[0]

@@ -91,8 +91,15 @@ def test_fractional_order_outside_unit_interval_refused(alpha):
     assert err.key == "material.fractional_order" and "(0, 1]" in str(err)
 
 
-def test_fractional_order_one_accepted():
-    Material(2e6, 1e5, 1.0, 1e4, 1e-3)
+def test_fractional_order_one_accepted_and_is_a_viscous_damper():
+    """α = 1 is allowed: m D¹ε is a viscous stress m dε/dt, whose modulus is iωm/2."""
+    from core.material import fractional_modulus
+
+    material = Material(2e6, 1e5, 1.0, 1e4, 1e-3)
+    assert material.fractional_order == 1.0
+    f = [0.5, 10.0, 300.0]
+    expected = [1j * math.pi * fi * 1e5 for fi in f]
+    assert fractional_modulus(f, material.fractional_coefficient, material.fractional_order) == pytest.approx(expected)
 
 
 @pytest.mark.parametrize("value", [float("nan"), float("inf"), "2e6", None, True, [1]])

@@ -71,8 +71,11 @@ def test_a_hidden_effect_is_named_and_the_gap_falls_to_the_noise(effect_id):
     assert step.gap_after < step.gap_before
     assert result.baseline.gap > 1.1 * result.final.gap  # the effect was visible …
     assert result.final.gap < 1.1 * NOISE_GAP  # … and is gone
-    for name, value in truth.items():  # its parameters are those hidden
+    for name, value in truth.items():  # its parameters are those hidden, within their errors
         assert step.parameters[name] == pytest.approx(value, rel=0.15), name
+        error = step.standard_errors[name]
+        assert 0 < error < abs(step.parameters[name]), name
+        assert abs(step.parameters[name] - value) < 5 * error + 1e-9 * abs(value), (name, step.parameters[name], error)
     assert result.noise_gap == pytest.approx(NOISE_GAP, rel=0.15)
 
 
@@ -154,8 +157,9 @@ def test_the_report_and_predictions_follow_formats_md():
     for key in ("baseline", "added", "steps", "gap_baseline", "gap_final", "unexplained"):
         assert key in report
     step = report["steps"][0]
-    for key in ("effect", "title", "where", "evidence", "parameters", "gap_before", "gap_after"):
+    for key in ("effect", "title", "where", "evidence", "parameters", "standard_errors", "gap_before", "gap_after"):
         assert key in step
+    assert set(step["standard_errors"]) == set(step["parameters"])
     assert step["evidence"]["bic_drop"] > 10
     assert step["gap_before"] == report["gap_baseline"] and step["gap_after"] == report["gap_final"]
     # the final design is a design file whose stiffness is the predictions' final columns,

@@ -1,0 +1,69 @@
+"""The models the diagnosis fits: a design with a subset of the thesis' branches, extended by
+effects of the library."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from ..design import Design
+from ..effects import EFFECTS
+from ..fit import with_values
+
+BRANCHES = ("elastic", "fractional", "friction")
+BRANCH_PARAMETERS = {
+    "elastic": ("shear_modulus",),
+    "fractional": ("fractional_coefficient", "fractional_order"),
+    "friction": ("friction_stress_max", "friction_strain_half"),
+}
+# a branch switched off: its modulus 1e-30 Pa, thirty orders below any rubber's
+OFF = {"shear_modulus": 1e-30, "fractional_coefficient": 1e-30, "friction_stress_max": 1e-30}
+
+
+@dataclass(frozen=True)
+class Model:
+    """A design with a subset of the thesis' branches (the others held at :data:`OFF`)."""
+
+    design: Design
+    branches: tuple[str, ...] = BRANCHES
+
+    @property
+    def parts(self) -> tuple[str, ...]:
+        """Branches and effects: what the model has."""
+        return (*self.branches, *(eid for eid, _ in self.design.effects))
+
+    @property
+    def free(self) -> tuple[str, ...]:
+        names = [p for b in self.branches for p in BRANCH_PARAMETERS[b]]
+        names += [f"{eid}.{p}" for eid, params in self.design.effects for p, _ in params]
+        return tuple(names)
+
+    def add(self, effect_id: str, values: dict[str, float]) -> Model:
+        if EFFECTS[effect_id].branch:
+            branches = tuple(b for b in BRANCHES if b in self.branches or b == effect_id)
+            return Model(with_values(self.design, values), branches)
+        effects = {**self.design.effect_parameters, effect_id: values}
+        return Model(self.design.replace(effects=effects), self.branches)
+
+
+def baseline_model(design: Design, branches: Iterable[str] = BRANCHES) -> Model:
+    branches = tuple(branches)
+    unknown = [b for b in branches if b not in BRANCHES]
+    if unknown or not branches:
+        raise ValueError(f"baseline: give one or more of {', '.join(BRANCHES)}, got {','.join(branches) or 'none'}")
+    off = {p: OFF[p] for b in BRANCHES if b not in branches for p in BRANCH_PARAMETERS[b] if p in OFF}
+    return Model(with_values(design, off), tuple(b for b in BRANCHES if b in branches))
+
+
+def candidates(model: Model) -> list[str]:
+    """The effects that can extend ``model``: not in it, whatever they act on present, nothing
+    they exclude present."""
+    parts = set(model.parts)
+    out = []
+    for eid, effect in EFFECTS.items():
+        if eid in parts or any(x in parts for x in effect.excludes):
+            continue
+        if effect.requires and not any(r in parts for r in effect.requires):
+            continue
+        out.append(eid)
+    return out

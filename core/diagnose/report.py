@@ -1,0 +1,145 @@
+"""What the diagnosis returns: fitted models, the accepted steps, the report and its summary."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..data import MeasuredStiffness, loss_factor
+from ..design import Design
+from ..fit import FitResult
+from .model import Model
+from .statistics import BIC_THRESHOLD
+
+
+@dataclass(frozen=True)
+class Fitted:
+    """A model fitted to the data, with its residual statistics."""
+
+    model: Model
+    fit: FitResult
+    stiffness: np.ndarray  # the model's complex K at the data points
+    residual: np.ndarray  # relative_residual(stiffness, data.stiffness)
+    bic: float
+
+    @property
+    def design(self) -> Design:
+        return self.fit.design
+
+    @property
+    def gap(self) -> float:
+        return self.fit.gap
+
+    @property
+    def mean_square(self) -> float:
+        return float(np.mean(np.abs(self.residual) ** 2))
+
+
+@dataclass(frozen=True)
+class Step:
+    effect: str
+    title: str
+    where: str
+    bic_drop: float
+    explained_fraction: float | None
+    parameters: dict[str, float]
+    gap_before: float
+    gap_after: float
+    candidates: dict[str, float]  # every candidate's BIC drop at this step
+    extra: dict = field(default_factory=dict)  # more evidence (the partner of a pair)
+    standard_errors: dict[str, float] = field(default_factory=dict)  # of ``parameters``, linearised
+
+    def report(self) -> dict:
+        evidence = {"bic_drop": self.bic_drop, "candidates_bic_drop": self.candidates, **self.extra}
+        if self.explained_fraction is not None:
+            evidence["explained_fraction"] = self.explained_fraction
+        errors = {k: (v if math.isfinite(v) else None) for k, v in self.standard_errors.items()}
+        return {"effect": self.effect, "title": self.title, "where": self.where, "evidence": evidence,
+                "parameters": self.parameters, "standard_errors": errors, "gap_before": self.gap_before,
+                "gap_after": self.gap_after}
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    data: MeasuredStiffness
+    baseline: Fitted
+    steps: list[Step]
+    final: Fitted
+    noise_variance: float | None
+    unexplained: bool
+    where_baseline: str
+    where_remaining: str
+    held_out: dict = field(default_factory=dict)
+
+    @property
+    def added(self) -> list[str]:
+        return [s.effect for s in self.steps]
+
+    @property
+    def noise_gap(self) -> float | None:
+        """The gap pure noise of the estimated size gives."""
+        return None if self.noise_variance is None else math.sqrt(self.noise_variance)
+
+    def report(self) -> dict:
+        """The report of docs/files.md's ``bushing diagnose``."""
+        out = {
+            "baseline": list(self.baseline.model.branches),
+            "added": self.added,
+            "steps": [s.report() for s in self.steps],
+            "gap_baseline": self.baseline.gap,
+            "gap_final": self.final.gap,
+            "unexplained": self.unexplained,
+            "where_baseline": self.where_baseline,
+            "where_remaining": self.where_remaining,
+            "noise_gap": self.noise_gap,
+            "points": len(self.data),
+            "bic_threshold": BIC_THRESHOLD,
+            "design": self.final.design.to_dict(),
+        }
+        if self.baseline.design.effects:
+            out["baseline_effects"] = [eid for eid, _ in self.baseline.design.effects]
+        if self.held_out:
+            out["held_out"] = self.held_out
+        return out
+
+    def to_json(self) -> str:
+        """The report as JSON text (strict: no NaN)."""
+        return json.dumps(self.report(), indent=2, allow_nan=False) + "\n"
+
+    def predictions(self) -> dict[str, np.ndarray]:
+        """Per data row: the baseline's and the final model's |K| and loss factor."""
+        kb, kf = self.baseline.stiffness, self.final.stiffness
+        return {
+            "frequency_hz": self.data.frequency_hz,
+            "amplitude": self.data.amplitude,
+            "baseline_magnitude": np.abs(kb),
+            "baseline_loss_factor": loss_factor(kb),
+            "final_magnitude": np.abs(kf),
+            "final_loss_factor": loss_factor(kf),
+        }
+
+
+def summary(diagnosis: Diagnosis) -> str:
+    """The diagnosis in plain words, a few lines (the command line's summary)."""
+    lines = [f"baseline ({', '.join(diagnosis.baseline.model.branches)}): gap {diagnosis.baseline.gap:.4g}"]
+    if diagnosis.noise_gap is not None:
+        lines[0] += f" (noise alone gives about {diagnosis.noise_gap:.4g})"
+    lines.append(f"  where it disagrees: {diagnosis.where_baseline}")
+    for n, s in enumerate(diagnosis.steps, 1):
+        params = ", ".join(f"{k} = {v:.4g}" + (f" ± {s.standard_errors[k]:.2g}" if math.isfinite(s.standard_errors.get(k, math.nan)) else "")
+                           for k, v in s.parameters.items()) or "no parameters"
+        lines.append(f"step {n}: add {s.effect} ({s.title}): {params}; BIC drop {s.bic_drop:.1f}; "
+                     f"gap {s.gap_before:.4g} -> {s.gap_after:.4g}")
+    if not diagnosis.steps:
+        lines.append("no effect of the library is needed: nothing added")
+    if diagnosis.unexplained:
+        lines.append(f"unexplained: a misfit above the noise remains, no effect of the library explains it: "
+                     f"{diagnosis.where_remaining}")
+    held = diagnosis.held_out
+    if held:
+        lines.append(f"held out ({held['left_out']}): gap {held['gap_baseline']:.4g} baseline, "
+                     f"{held['gap_final']:.4g} final")
+    return "\n".join(lines) + "\n"

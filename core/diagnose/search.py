@@ -1,0 +1,221 @@
+"""The search: fit the baseline, try every candidate effect (and pairs), accept what the data
+support, check on held-out data."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..bushing import stiffness_points
+from ..data import MeasuredStiffness
+from ..design import Design
+from ..effects import EFFECTS
+from ..fit import fit_global, gap, parameter, parameter_values, relative_residual
+from ..material import ConvergenceError
+from .model import BRANCHES, Model, baseline_model, candidates
+from .report import Diagnosis, Fitted, Step
+from .statistics import BIC_THRESHOLD, NOISE_RATIO, bic, explains, lower, noise_variance, runs
+from .words import describe
+
+PAIR_POOL = 4  # pairs are sought among the four best single candidates
+MAX_FOLDS, HELD_OUT_BANDS = 12, 5  # held-out folds: single values up to 12, else 5 bands
+GRID_1D, GRID_2D = 16, 9  # starting-value grids of a candidate's parameters
+BASELINE_STARTS = 8
+
+Progress = Callable[[float, str], None]
+
+
+@dataclass(frozen=True)
+class Accepted:
+    """An effect the search accepted: the model before and after it, every candidate's BIC drop
+    at that step, the fit whose values it reports (a pair's joint fit) and more evidence."""
+
+    effect: str
+    before: Fitted
+    after: Fitted
+    drops: dict[str, float]
+    values_from: Fitted
+    evidence: dict = field(default_factory=dict)
+
+
+def _fit(model: Model, data: MeasuredStiffness, **kwargs) -> Fitted:
+    result = fit_global(model.design, data, free=model.free, **kwargs)
+    k = stiffness_points(result.design, data.frequency_hz, data.amplitude)
+    residual = relative_residual(k, data.stiffness)
+    return Fitted(Model(result.design, model.branches), result, k, residual, bic(residual, len(model.free)))
+
+
+def _grid_values(names: list[str], n: int) -> list[dict[str, float]]:
+    axes = []
+    for name in names:
+        spec = parameter(name)
+        lo, hi = spec.bounds
+        axes.append(np.geomspace(lo, hi, n + 2)[1:-1] if spec.log else np.linspace(lo, hi, n + 2)[1:-1])
+    mesh = np.meshgrid(*axes, indexing="ij")
+    return [dict(zip(names, (float(m.flat[i]) for m in mesh))) for i in range(mesh[0].size)]
+
+
+def _candidate_starts(current: Fitted, effect_id: str, data: MeasuredStiffness, keep: int = 2):
+    """Starting values for a candidate's parameters: the best ``keep`` of a grid across their
+    fitting ranges, the rest of the model held at its fitted values."""
+    effect = EFFECTS[effect_id]
+    names = [p.name if effect.branch else f"{effect_id}.{p.name}" for p in effect.parameters]
+    if not names:
+        return [{}]
+    grid = _grid_values(names, GRID_1D if len(names) == 1 else GRID_2D)
+    scored = []
+    for values in grid:
+        trial = current.model.add(effect_id, {n.rpartition(".")[2]: v for n, v in values.items()})
+        try:
+            k = stiffness_points(trial.design, data.frequency_hz, data.amplitude)
+        except (ValueError, ArithmeticError, ConvergenceError):
+            continue
+        r = relative_residual(k, data.stiffness)
+        if np.all(np.isfinite(r)):
+            scored.append((float(np.sum(np.abs(r) ** 2)), values))
+    scored.sort(key=lambda s: s[0])
+    return [v for _, v in scored[:keep]] or [grid[len(grid) // 2]]
+
+
+def _fit_candidate(current: Fitted, effect_id: str, data: MeasuredStiffness) -> Fitted | None:
+    starts = _candidate_starts(current, effect_id, data)
+    model = current.model.add(effect_id, {n.rpartition(".")[2]: v for n, v in starts[0].items()})
+    base = parameter_values(current.design)
+    try:
+        return _fit(model, data, initial=[{**base, **s} for s in starts])
+    except (ValueError, ArithmeticError, ConvergenceError):
+        return None  # the extended model cannot be fitted to these data: not a candidate
+
+
+def _held_out(data: MeasuredStiffness, fits: dict[str, Fitted]) -> dict:
+    """Leave one amplitude out (or, with fewer than three amplitudes, one frequency): refit each
+    model on the rest from its fitted values, predict the points left out; the gap over them.
+    With more than :data:`MAX_FOLDS` distinct values (scattered data), bands of equal count are
+    left out instead of single values."""
+    for axis, values in (("amplitude", data.amplitude), ("frequency", data.frequency_hz)):
+        levels = np.unique(values)
+        if levels.size >= 3:
+            break
+    else:
+        return {}
+    what = f"one {axis} at a time"
+    if levels.size > MAX_FOLDS:
+        edges = np.quantile(values, np.linspace(0, 1, HELD_OUT_BANDS + 1))
+        values = np.clip(np.searchsorted(edges, values, side="right") - 1, 0, HELD_OUT_BANDS - 1)
+        levels = np.unique(values)
+        what = f"one {axis} band of {HELD_OUT_BANDS} at a time"
+    out: dict = {"left_out": what, "folds": int(levels.size)}
+    done: dict[int, float] = {}
+    for label, fitted in fits.items():
+        if id(fitted) in done:  # the same model (nothing was added): the same figure
+            out[f"gap_{label}"] = done[id(fitted)]
+            continue
+        predicted = np.empty(len(data), dtype=complex)
+        for level in levels:
+            held = values == level
+            try:
+                refit = fit_global(fitted.design, data.select(~held), free=fitted.model.free, initial=[{}])
+            except (ValueError, ArithmeticError, ConvergenceError):
+                return {}  # too few points left to refit on: no held-out figure
+            predicted[held] = stiffness_points(refit.design, data.frequency_hz[held], data.amplitude[held])
+        out[f"gap_{label}"] = done[id(fitted)] = gap(predicted, data.stiffness)
+    return out
+
+
+def _best_pair(current: Fitted, tried: dict[str, Fitted], drops: dict[str, float],
+               data: MeasuredStiffness, say: Progress, done: float):
+    """The best pair of candidates fitted together, each needed (the pair beats either alone by
+    more than the threshold); ``None`` if no pair is."""
+    ranked = [eid for eid in sorted(drops, key=drops.get, reverse=True) if drops[eid] > 0][:PAIR_POOL]
+    best = None
+    for i, a in enumerate(ranked):
+        for b in ranked[i + 1:]:
+            if b not in candidates(tried[a].model):
+                continue
+            say(done, f"trying {EFFECTS[a].title.lower()} with {EFFECTS[b].title.lower()}")
+            joint = _fit_candidate(tried[a], b, data)
+            if joint is None:
+                continue
+            needed = min(tried[a].bic, tried[b].bic) - joint.bic
+            better = best is None or joint.bic < best[1].bic
+            if needed > BIC_THRESHOLD and current.bic - joint.bic > BIC_THRESHOLD and better:
+                best = ((a, b), joint)
+    return best
+
+
+def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str] = BRANCHES,
+             held_out: bool = True, progress: Progress | None = None) -> Diagnosis:
+    """Run the discrepancy workflow on ``data`` from ``design`` (its geometry known, its
+    parameters the starting values) with the ``baseline`` branches. Returns a :class:`Diagnosis`.
+    """
+    say = progress or (lambda fraction, message: None)
+    triples = runs(data)
+    say(0.0, "fitting the baseline")
+    current = _fit(baseline_model(design, baseline), data, starts=BASELINE_STARTS)
+    first = current
+    noise = noise_variance(current.residual, data, triples)
+    accepted: list[Accepted] = []
+    done = 0.1  # progress: each round of candidates takes half of what is left up to 0.8
+    while True:
+        names = candidates(current.model)
+        tried: dict[str, Fitted] = {}
+        span = (0.8 - done) / 2
+        for i, eid in enumerate(names):
+            say(done + span * i / len(names), f"step {len(accepted) + 1}: trying {EFFECTS[eid].title.lower()}")
+            fitted = _fit_candidate(current, eid, data)
+            if fitted is not None:
+                tried[eid] = fitted
+                noise = lower(noise, noise_variance(fitted.residual, data, triples))
+        done += span
+        drops = {eid: current.bic - f.bic for eid, f in tried.items()}
+        if not drops:
+            break
+        best = max(drops, key=drops.get)
+        if drops[best] > BIC_THRESHOLD and explains(current, tried[best], noise)[0]:
+            accepted.append(Accepted(best, current, tried[best], drops, tried[best]))
+            current = tried[best]
+            continue
+        # no single effect explains the misfit: two that act together may (their fits interact
+        # through the refitted baseline, so neither alone need explain much)
+        pair = _best_pair(current, tried, drops, data, say, done)
+        if pair is None:
+            break
+        (first_id, second_id), joint = pair
+        noise = lower(noise, noise_variance(joint.residual, data, triples))
+        if not explains(current, joint, noise)[0]:
+            break
+        accepted.append(Accepted(first_id, current, tried[first_id], drops, joint, {"found_with": second_id}))
+        accepted.append(Accepted(second_id, tried[first_id], joint, {second_id: tried[first_id].bic - joint.bic},
+                                 joint, {"found_with": first_id}))
+        current = joint
+    remaining = noise is not None and current.mean_square > NOISE_RATIO * noise
+
+    # the words, with the final noise estimate: each misfit described once
+    sd = math.sqrt((noise or current.mean_square) / 2.0)
+    words: dict[int, str] = {}
+
+    def where(fitted: Fitted) -> str:
+        if id(fitted) not in words:
+            words[id(fitted)] = describe(data, fitted.stiffness, design.mode, sd)
+        return words[id(fitted)]
+
+    steps = []
+    for a in accepted:
+        effect = EFFECTS[a.effect]
+        values = parameter_values(a.values_from.design)
+        names = {p.name: p.name if effect.branch else f"{a.effect}.{p.name}" for p in effect.parameters}
+        params = {p: values[n] for p, n in names.items()}
+        errors = {p: a.values_from.fit.standard_errors.get(n, math.nan) for p, n in names.items()}
+        steps.append(Step(a.effect, effect.title, where(a.before), a.before.bic - a.after.bic,
+                          explains(a.before, a.after, noise)[1], params, a.before.gap, a.after.gap, a.drops,
+                          a.evidence, errors))
+    held = {}
+    if held_out:
+        say(0.85, "checking on held-out data")
+        held = _held_out(data, {"baseline": first, "final": current})
+    say(1.0, "done")
+    return Diagnosis(data, first, steps, current, noise, remaining, where(first),
+                     where(current) if remaining else "no misfit above the noise.", held)
