@@ -13,7 +13,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from core import Design
-from core.bushing import branch_stiffness, loop, material_model, stiffness, strain_factor
+from core.bushing import (
+    MAX_STRAIN,
+    branch_stiffness,
+    loop,
+    material_model,
+    stiffness,
+    strain_factor,
+)
 from core.data import MeasuredLoop, MeasuredStiffness, loss_factor, magnitude_residual_pct
 from core.material import ConvergenceError
 
@@ -33,9 +40,11 @@ def fletcher_gent_amplitudes(design: Design, n: int = 5, ratios=None) -> np.ndar
 
 
 def amplitude_bounds(design: Design) -> tuple[float, float]:
-    """The amplitude axis (display units): the Fletcher–Gent range."""
+    """The amplitude axis (display units): the Fletcher–Gent range, up to the largest strain the
+    core computes (:data:`core.bushing.MAX_STRAIN`)."""
     x = fletcher_gent_amplitudes(design, 2)
-    return float(x[0]), float(x[1])
+    top = units.display_amplitude(MAX_STRAIN / strain_factor(design.geometry, design.mode), design.mode)
+    return float(min(x[0], top / 10)), float(min(x[1], top))
 
 
 def amplitude_grid(design: Design, n: int = 120) -> np.ndarray:
@@ -43,8 +52,9 @@ def amplitude_grid(design: Design, n: int = 120) -> np.ndarray:
 
 
 def sweep_amplitudes(design: Design) -> np.ndarray:
-    """The amplitudes of the frequency sweeps: ε̂/ε½ = 0.01, 0.1, 1 and 10."""
-    return fletcher_gent_amplitudes(design, ratios=SWEEP_STRAINS)
+    """The amplitudes of the frequency sweeps: ε̂/ε½ = 0.01, 0.1, 1 and 10 (within the amplitude
+    axis)."""
+    return np.minimum(fletcher_gent_amplitudes(design, ratios=SWEEP_STRAINS), amplitude_bounds(design)[1])
 
 
 def sweep_frequencies(freq_min: float, freq_max: float) -> np.ndarray:

@@ -160,6 +160,20 @@ def _effective_slices(design: Design, slices: int | str) -> int | str:
     return "continuum" if slices == 1 and "nonuniform_strain" in design.effect_parameters else slices
 
 
+MAX_STRAIN = 10.0  # equivalent strain amplitude: 1000 %, far past any rubber's breaking strain
+
+
+def check_strain(design: Design, amplitude) -> None:
+    """Refuse drive amplitudes whose equivalent strain is beyond :data:`MAX_STRAIN`: no rubber
+    survives them, and the formulas' numbers stop being meaningful long before floats fail."""
+    x = np.asarray(amplitude, dtype=float)
+    if x.size and float(np.max(strain_factor(design.geometry, design.mode) * x)) > MAX_STRAIN:
+        unit = UNITS[design.mode]["amplitude"]
+        largest = MAX_STRAIN / strain_factor(design.geometry, design.mode)
+        raise ValueError(f"amplitude: at most {largest:.4g} {unit} for this bushing (an equivalent strain of "
+                         f"{MAX_STRAIN:g}, {100 * MAX_STRAIN:g} %); got {float(np.max(x)):.4g} {unit}")
+
+
 def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | str = 1,
                      route: Route = "analytic") -> np.ndarray:
     """Complex stiffness at paired points (frequency_hz[i], amplitude[i]), broadcast together:
@@ -173,6 +187,7 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
     if route not in ROUTES:
         raise ValueError(f"route: must be one of {', '.join(ROUTES)}, got {route!r}")
     geo, mode = design.geometry, design.mode
+    check_strain(design, x)
     effects = design.effect_parameters
     modulus = modulus_function(design, route)
     c = strain_factor(geo, mode)
@@ -334,6 +349,7 @@ def loop(
     """
     f = float(_grid("frequency_hz", frequency_hz)[0])
     xa = float(_grid("amplitude", amplitude)[0])
+    check_strain(design, xa)
     if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 4:
         raise ValueError(f"points: must be a whole number ≥ 4, got {points!r}")
     _refuse_structural_effects(design, "the branch-by-branch hysteresis loop")

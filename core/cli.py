@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 import sys
+import warnings
 from contextlib import contextmanager
 
 import numpy as np
@@ -19,6 +21,12 @@ from .design import DesignError, read_design
 from .material import ConvergenceError
 
 NUMBER_FORMAT = "{:.12g}"
+# the largest sizes the command line computes (docs/files.md): a grid of at most a million
+# points, a loop of at most a million samples
+MAX_FREQUENCIES = 100_000
+MAX_GRID = 1_000_000
+MAX_LOOP_POINTS = 1_000_000
+NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
 
 
 class InputError(Exception):
@@ -32,10 +40,9 @@ class _Parser(argparse.ArgumentParser):
 
 def _positive(name):
     def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
+        if not NUMBER.fullmatch(str(text).strip()):  # Python's float() also takes "1_000", "nan", "inf"
             raise argparse.ArgumentTypeError(f"{name} must be a number, got {text!r}")
+        value = float(text)
         if not math.isfinite(value) or value <= 0:
             raise argparse.ArgumentTypeError(f"{name} must be a positive finite number, got {text!r}")
         return value
@@ -43,14 +50,15 @@ def _positive(name):
     return parse
 
 
-def _count(name, minimum=1):
+def _count(name, minimum=1, maximum=None):
     def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
+        if not re.fullmatch(r"[-+]?\d+", str(text).strip()):
             raise argparse.ArgumentTypeError(f"{name} must be a whole number, got {text!r}")
+        value = int(text)
         if value < minimum:
             raise argparse.ArgumentTypeError(f"{name} must be at least {minimum}, got {text!r}")
+        if maximum is not None and value > maximum:
+            raise argparse.ArgumentTypeError(f"{name} must be at most {maximum}, got {text!r}")
         return value
 
     return parse
@@ -125,7 +133,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--amp", required=True, type=_positive("--amp"), metavar="A", help="peak, m or rad"
     )
     lp.add_argument(
-        "--points", type=_count("--points", 4), default=256, metavar="N", help="default 256"
+        "--points", type=_count("--points", 4, MAX_LOOP_POINTS), default=256, metavar="N",
+        help=f"default 256, at most {MAX_LOOP_POINTS}"
     )
     lp.add_argument("-o", dest="output", metavar="OUT.csv", help="write here, not to stdout")
     ft = sub.add_parser(
@@ -169,15 +178,33 @@ def _measured_arguments(parser: argparse.ArgumentParser, design_help: str) -> No
 def _frequencies(args) -> np.ndarray:
     f1 = _positive("--freq F1")(args.freq[0])
     f2 = _positive("--freq F2")(args.freq[1])
-    n = _count("--freq N")(args.freq[2])
+    n = _count("--freq N", 1, MAX_FREQUENCIES)(args.freq[2])
     if n == 1 and f1 != f2:
         raise InputError("bushing stiffness: --freq with N = 1 needs F1 = F2")
     return np.geomspace(f1, f2, n) if args.log else np.linspace(f1, f2, n)
 
 
+def _finite(columns: dict) -> dict:
+    """``columns`` if every number is finite; else say so (a design or drive outside what the
+    formulas can represent, never a column of NaN)."""
+    for name, values in columns.items():
+        if not np.all(np.isfinite(np.asarray(values, dtype=float))):
+            raise ComputationError(f"bushing: the {name} is not a finite number for this design and drive "
+                                   "(outside what the formulas can represent)")
+    return columns
+
+
+class ComputationError(Exception):
+    """A result that cannot be given: exit status 1."""
+
+
 def _write_text(text: str, output: str | None) -> None:
     if output is None:
-        sys.stdout.write(text)
+        try:
+            sys.stdout.write(text)
+            sys.stdout.flush()
+        except OSError as exc:
+            raise InputError(f"bushing: cannot write to standard output: {exc.strerror}")
         return
     try:
         with open(output, "w", encoding="utf-8", newline="") as fh:
@@ -195,6 +222,9 @@ def _cmd_stiffness(args) -> None:
         freqs = _frequencies(args)
     except argparse.ArgumentTypeError as exc:
         raise InputError(f"bushing stiffness: {exc}")
+    if freqs.size * len(args.amp) > MAX_GRID:
+        raise InputError(f"bushing stiffness: {freqs.size} frequencies × {len(args.amp)} amplitudes is more "
+                         f"than {MAX_GRID} points; ask for fewer")
     design = read_design(args.design)
     result = stiffness(
         design,
@@ -203,13 +233,13 @@ def _cmd_stiffness(args) -> None:
         slices="continuum" if args.continuum else args.slices,
         route=args.route,
     )
-    _write_csv(result.table(), args.output)
+    _write_csv(_finite(result.table()), args.output)
 
 
 def _cmd_loop(args) -> None:
     design = read_design(args.design)
     result = loop(design, args.freq, args.amp, args.points)
-    _write_csv(result.table(), args.output)
+    _write_csv(_finite(result.table()), args.output)
 
 
 @contextmanager
@@ -221,8 +251,8 @@ def _one_line_errors():
         _fail(str(exc), 2)
     except (DesignError, DataError, ValueError) as exc:
         _fail(f"bushing: {exc}", 2)
-    except ConvergenceError as exc:
-        _fail(f"bushing: {exc}", 1)
+    except (ConvergenceError, ComputationError) as exc:
+        _fail(f"bushing: {exc}" if isinstance(exc, ConvergenceError) else str(exc), 1)
     except KeyboardInterrupt:
         _fail("bushing: interrupted", 130)
     except Exception as exc:  # noqa: BLE001 - the last guard: one line, never a traceback
@@ -272,9 +302,22 @@ def main(argv: list[str] | None = None, parser: argparse.ArgumentParser | None =
          commands: dict | None = None) -> int:
     """Run one command. ``parser`` and ``commands`` extend the core's (``app.cli`` adds ``serve``:
     the command line's core knows nothing of the browser app)."""
-    with _one_line_errors():
+    argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
+    with _one_line_errors(), warnings.catch_warnings(), np.errstate(all="ignore"):
+        warnings.simplefilter("ignore")  # numerical warnings never reach users: results are checked
+        option = ""
+        for token in argv:
+            if token.startswith("-") and NUMBER.fullmatch(token):
+                raise InputError(f"bushing: {option} {token}: every number on the command line is positive "
+                                 "(amplitudes, frequencies, counts)")
+            if token.startswith("-"):
+                option = token
         args = (parser or build_parser()).parse_args(argv)
         (commands or COMMANDS)[args.command](args)
+        try:
+            sys.stdout.flush()
+        except OSError as exc:
+            raise InputError(f"bushing: cannot write to standard output: {exc.strerror}")
     return 0
 
 

@@ -274,6 +274,10 @@ def parse_stiffness(text: str | bytes) -> MeasuredStiffness:
         bad = np.flatnonzero(np.abs(k) == 0)
         if bad.size:
             raise DataError(f"line {bad[0] + 2}: the stiffness is zero")
+    active = np.flatnonzero(k.imag < 0)
+    if active.size:  # a passive specimen dissipates: Im K ≥ 0
+        raise DataError(f"line {active[0] + 2}: a negative loss factor (Im K < 0) would mean the bushing gives "
+                        "energy back each cycle; a rubber bushing cannot")
     return MeasuredStiffness(v["frequency_hz"], v["amplitude"], k)
 
 

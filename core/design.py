@@ -29,6 +29,8 @@ from pathlib import Path
 from typing import Any
 
 MODES = ("axial", "torsion")
+SIZE_RANGE = (1e-6, 1e3)  # m: radii and lengths from a micrometre to a kilometre, no further
+MAX_DESIGN_BYTES = 1_000_000  # a design file is a few hundred bytes; one of a megabyte is not one
 
 
 class DesignError(ValueError):
@@ -44,7 +46,10 @@ def _number(key: str, value: Any) -> float:
     """Return ``value`` as a finite float or refuse it, naming ``key``."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise DesignError(key, f"must be a number, got {value!r}")
-    value = float(value)
+    try:
+        value = float(value)
+    except OverflowError:  # an integer too large for a float
+        raise DesignError(key, "must be a finite number, got an integer too large for a float") from None
     if not math.isfinite(value):
         raise DesignError(key, f"must be a finite number, got {value!r}")
     return value
@@ -67,7 +72,11 @@ class Geometry:
 
     def __post_init__(self):
         for f in fields(self):
-            object.__setattr__(self, f.name, _positive(f"geometry.{f.name}", getattr(self, f.name)))
+            key = f"geometry.{f.name}"
+            value = _positive(key, getattr(self, f.name))
+            if not SIZE_RANGE[0] <= value <= SIZE_RANGE[1]:
+                raise DesignError(key, f"must lie between {SIZE_RANGE[0]:g} and {SIZE_RANGE[1]:g} m, got {value!r}")
+            object.__setattr__(self, f.name, value)
         if self.outer_radius <= self.inner_radius:
             raise DesignError(
                 "geometry.outer_radius",
@@ -207,17 +216,34 @@ def design_from_dict(data: Any) -> Design:
     )
 
 
+def _unique_keys(pairs):
+    keys = [k for k, _ in pairs]
+    repeated = sorted({k for k in keys if keys.count(k) > 1})
+    if repeated:
+        raise DesignError(repeated[0], "given twice (a design file names each key once)")
+    return dict(pairs)
+
+
 def loads_design(text: str) -> Design:
+    """A design from design-file text: JSON (no key twice, at most :data:`MAX_DESIGN_BYTES`),
+    then :func:`design_from_dict`'s rules (which refuse NaN and infinities by their key)."""
+    if len(text) > MAX_DESIGN_BYTES:
+        raise DesignError("", f"too large for a design file ({len(text)} characters; at most {MAX_DESIGN_BYTES})")
     try:
-        data = json.loads(text)
+        data = json.loads(text, object_pairs_hook=_unique_keys)  # NaN, Infinity: refused by the key's rule
     except json.JSONDecodeError as exc:
         raise DesignError("", f"not valid JSON: {exc.msg} at line {exc.lineno} column {exc.colno}")
+    except RecursionError:
+        raise DesignError("", "not a design file: nested too deeply") from None
     return design_from_dict(data)
 
 
 def read_design(path: str | Path) -> Design:
     path = Path(path)
     try:
+        if path.stat().st_size > MAX_DESIGN_BYTES:
+            raise DesignError("", f"design file {str(path)!r} is too large ({path.stat().st_size} bytes; "
+                              f"at most {MAX_DESIGN_BYTES})")
         text = path.read_text(encoding="utf-8-sig")  # a byte-order mark is not part of the JSON
     except OSError as exc:
         raise DesignError("", f"cannot read design file {str(path)!r}: {exc.strerror}")

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 from scipy import special
 
-from .design import DesignError, Material
+from .design import DesignError, Material, _number
 from .material import REFERENCE_FREQUENCY_HZ, fractional_modulus, friction_modulus
 
 
@@ -194,12 +194,10 @@ def validate_effects(effects: Any) -> dict[str, dict[str, float]]:
         for name in names:
             if name not in params:
                 raise DesignError(f"{key}.{name}", "missing (required)")
-            v = params[name]
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-                raise DesignError(f"{key}.{name}", f"must be a finite number, got {v!r}")
+            v = _number(f"{key}.{name}", params[name])
             if v < 0:
                 raise DesignError(f"{key}.{name}", f"must be ≥ 0, got {v!r}")
-            values[name] = float(v)
+            values[name] = v
         out[eid] = values
     return out
 

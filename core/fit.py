@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
-from .bushing import loop_force, stiffness_points
+from .bushing import check_strain, loop_force, stiffness_points
 from .data import MeasuredLoop, MeasuredStiffness
 from .design import Design, as_dict
 from .effects import EFFECTS, Parameter
@@ -107,11 +107,15 @@ class FitResult:
     history: list = field(default_factory=list)
 
     def report(self) -> dict:
-        """The ``fit`` object of the fitted design file (docs/files.md)."""
+        """The ``fit`` object of the fitted design file (docs/files.md). A number the data do
+        not define (a standard error or correlation of a degenerate fit) is null."""
+        def finite(v):
+            return float(v) if v is not None and math.isfinite(v) else None
+
         out = {
-            "standard_errors": self.standard_errors,
-            "correlation": self.correlation,
-            "gap": self.gap,
+            "standard_errors": {k: finite(v) for k, v in self.standard_errors.items()},
+            "correlation": {a: {b: finite(v) for b, v in row.items()} for a, row in self.correlation.items()},
+            "gap": finite(self.gap),
             "points": self.points,
             "method": self.method,
             "starts": self.starts,
@@ -125,7 +129,7 @@ class FitResult:
 
     def to_json(self) -> str:
         """The fitted design file (docs/files.md): the design and its ``fit`` object."""
-        return json.dumps(self.to_dict(), indent=2) + "\n"
+        return json.dumps(self.to_dict(), indent=2, allow_nan=False) + "\n"
 
 
 class _Problem:
@@ -273,6 +277,10 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     """
     if data is None and loop is None:
         raise ValueError("give measured stiffness, a measured loop, or both")
+    if data is not None:
+        check_strain(design, data.amplitude)  # the measured amplitudes, for this bushing
+    if loop is not None:
+        check_strain(design, np.max(np.abs(loop.displacement - np.mean(loop.displacement))))
     n = (0 if data is None else 2 * len(data)) + (0 if loop is None else loop.force.size)
     if n <= len(free):
         raise ValueError(f"{n // 2} points cannot determine {len(free)} parameters")

@@ -1,0 +1,132 @@
+"""Hostile input to the command line: every case ends with exit status 2 (or 1 for a result the
+formulas cannot give) and one line on standard error; never a traceback, a warning, a hang or a
+NaN in an output."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core import PAPER_B, write_design
+from core.data import MeasuredStiffness
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+DESIGN = json.loads((EXAMPLES / "paper_b_true.json").read_text())
+
+
+def bushing(*argv, stdout=subprocess.PIPE, timeout=60):
+    return subprocess.run([sys.executable, "-m", "app.cli", *map(str, argv)], stdout=stdout,
+                          stderr=subprocess.PIPE, text=True, timeout=timeout, check=False)
+
+
+def design_file(tmp_path, text, name="d.json"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def edited(change) -> str:
+    text = json.dumps(DESIGN)
+    for old, new in change:
+        assert old in text, old
+        text = text.replace(old, new)
+    return text
+
+
+HUGE = "1" + "0" * 400
+DESIGNS = {
+    "an integer too large for a float": (edited([('"shear_modulus": 2420000.0', f'"shear_modulus": {HUGE}')]),
+                                         "material.shear_modulus"),
+    "an effect's integer too large": (edited([('"material": {', f'"effects": {{"inertia": {{"mass": {HUGE}}}}}, "material": {{')]),
+                                      "inertia"),
+    "nested thousands deep": ("[" * 20000 + "]" * 20000, "nested too deeply"),
+    "a key given twice": (edited([('"mode": "axial"', '"mode": "axial", "mode": "torsion"')]), "given twice"),
+    "NaN": (edited([('"shear_modulus": 2420000.0', '"shear_modulus": NaN')]), "material.shear_modulus"),
+    "radii of 1e-300 m": (edited([('"inner_radius": 0.02', '"inner_radius": 1e-300')]), "geometry.inner_radius"),
+    "an outer radius of 1e300 m": (edited([('"outer_radius": 0.035', '"outer_radius": 1e300')]), "geometry.outer_radius"),
+    "50 MB": ('{"name": "' + "x" * 50_000_000 + '"}', "too large"),
+}
+
+
+@pytest.mark.parametrize("case", list(DESIGNS))
+def test_hostile_design_files(case, tmp_path):
+    text, needle = DESIGNS[case]
+    path = design_file(tmp_path, text)
+    for argv in (("loop", path, "--freq", 1, "--amp", 1e-3), ("stiffness", path, "--freq", 1, 10, 2, "--amp", 1e-4)):
+        r = bushing(*argv)
+        assert r.returncode == 2 and r.stdout == "", (case, r.stderr)
+        assert r.stderr.count("\n") == 1 and needle in r.stderr, (case, r.stderr)
+
+
+OPTIONS = {
+    "a loop of 1e14 points": (("loop", "{d}", "--freq", 1, "--amp", 1e-3, "--points", 99999999999999), "at most"),
+    "ten million frequencies": (("stiffness", "{d}", "--freq", 1, 100, 10000000, "--amp", 1e-3), "at most"),
+    "a grid over a million points": (("stiffness", "{d}", "--freq", 1, 100, 100000, "--amp", *([1e-4] * 20)), "points"),
+    "a negative amplitude": (("stiffness", "{d}", "--freq", 1, 100, 3, "--amp", -1e-3), "--amp"),
+    "an amplitude of 1e300, continuum": (("stiffness", "{d}", "--freq", 1, 100, 3, "--amp", 1e300, "--continuum"),
+                                         "amplitude"),
+    "an amplitude of 1e300, loop": (("loop", "{d}", "--freq", 1, "--amp", 1e300), "amplitude"),
+    "underscores in a number": (("stiffness", "{d}", "--freq", 1, 100, 3, "--amp", "4_858_578"), "--amp"),
+    "inf": (("loop", "{d}", "--freq", "inf", "--amp", 1e-3), "--freq"),
+}
+
+
+@pytest.mark.parametrize("case", list(OPTIONS))
+def test_hostile_options(case):
+    argv, needle = OPTIONS[case]
+    r = bushing(*(str(a).format(d=EXAMPLES / "paper_b_true.json") for a in argv))
+    assert r.returncode == 2 and r.stdout == "", (case, r.stderr)
+    assert r.stderr.count("\n") == 1 and needle in r.stderr and "Traceback" not in r.stderr, (case, r.stderr)
+
+
+def stiffness_csv(path, rows):
+    path.write_text("frequency_hz,amplitude,magnitude,loss_factor\n" + "".join(",".join(map(str, r)) + "\n" for r in rows))
+    return path
+
+
+def test_hostile_measured_files(tmp_path):
+    design = EXAMPLES / "paper_b_true.json"
+    good = [(f, a, 4.2e6, 0.14) for f in (1, 10, 100) for a in (1e-5, 1e-4, 1e-3)]
+    cases = {
+        "an amplitude of 1e300": ([*good, (10, 1e300, 4e6, 0.1)], "amplitude"),
+        "a negative loss factor": ([*good, (10, 1e-4, 4e6, -0.1)], "negative loss factor"),
+    }
+    for case, (rows, needle) in cases.items():
+        path = stiffness_csv(tmp_path / "m.csv", rows)
+        for command in ("fit", "diagnose"):
+            r = bushing(command, path, "--design", design)
+            assert r.returncode == 2 and r.stdout == "", (case, command, r.stderr)
+            assert r.stderr.count("\n") == 1 and needle in r.stderr, (case, command, r.stderr)
+
+
+def test_a_full_standard_output_is_a_message_not_a_traceback():
+    with open("/dev/full", "w") as full:
+        r = bushing("stiffness", EXAMPLES / "paper_b_true.json", "--freq", 1, 100, 3, "--amp", 1e-4, stdout=full)
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and "standard output" in r.stderr
+
+
+def test_a_fit_to_one_point_repeated_writes_valid_json(tmp_path):
+    """150 copies of one point cannot determine five parameters: whatever the fit says, its
+    file is strict JSON (no NaN, no Infinity)."""
+    k = 4.2e6 * (1 + 0.14j) / np.sqrt(1 + 0.14**2)
+    data = MeasuredStiffness(np.full(150, 10.0), np.full(150, 1e-4), np.full(150, k))
+    data.to_csv(tmp_path / "same.csv")
+    r = bushing("fit", tmp_path / "same.csv", "--design", EXAMPLES / "paper_b_true.json")
+    assert "Traceback" not in r.stderr and "Warning" not in r.stderr
+    if r.returncode == 0:
+        report = json.loads(r.stdout, parse_constant=lambda c: pytest.fail(f"{c} in the fit file"))
+        assert set(report["fit"]["standard_errors"]) == {"shear_modulus", "fractional_coefficient", "fractional_order",
+                                                          "friction_stress_max", "friction_strain_half"}
+    else:
+        assert r.returncode == 2 and r.stderr.count("\n") == 1
+
+
+def test_no_warning_reaches_the_user_on_success(tmp_path):
+    design = tmp_path / "d.json"
+    write_design(PAPER_B.replace(effects={"wave_effects": {"density": 1200.0}}), design)
+    r = bushing("stiffness", design, "--freq", 1, 5000, 50, "--log", "--amp", 1e-6, 1e-3, 0.05)
+    assert r.returncode == 0 and r.stderr == ""
+    assert "nan" not in r.stdout.lower() and "inf" not in r.stdout.lower()
