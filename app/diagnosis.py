@@ -102,7 +102,7 @@ class DiagnosisView(pn.viewable.Viewer):
     # ---- events --------------------------------------------------------------------------------
 
     def _on_file(self, event):
-        if event.new:
+        if event.new is not None:  # an empty file too: it gets its message
             self.state.load_csv(event.new, self.file.filename or "stiffness file")
 
     async def _run(self, _event):

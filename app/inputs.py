@@ -61,7 +61,11 @@ class LogSlider(pn.viewable.Viewer):
         return min(max(v, math.log10(lo)), math.log10(hi))
 
     def _from_slider(self, event):
-        value = float(f"{10 ** event.new:.4g}")
+        position = event.new
+        if position is None or not math.isfinite(position):
+            return  # not a position (a hostile page): nothing moves
+        position = self._clip(position)  # within the slider, whatever the page sent
+        value = float(f"{10 ** position:.4g}")
         if not math.isclose(value, getattr(self._state, self._name), rel_tol=1e-3):
             setattr(self._state, self._name, value)
 

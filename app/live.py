@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import warnings
 from collections.abc import Callable
 
 import holoviews as hv
@@ -142,7 +143,8 @@ def update_or_keep(what: str, update) -> None:
     """Run ``update`` as :func:`one_change`. It never raises: an unexpected error keeps what is
     shown and is logged in one line, saying ``what`` was kept."""
     try:
-        with one_change():
+        with one_change(), warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")  # numbers are checked where they are made; no warning in the log
             update()
     except Exception as exc:  # noqa: BLE001 - keep the last view, say what happened
         log.warning("%s: %s: %s", what, type(exc).__name__, exc)

@@ -54,6 +54,7 @@ model (with the thesis' equation numbers), every file and the `bushing` command 
 
 
 URL_DELAY_MS = 300
+UPLOAD_MESSAGE_BYTES = 64 * 1024 * 1024
 
 
 class ShareLink(param.Parameterized):
@@ -218,6 +219,10 @@ def serve(port: int = 5006, address: str = "localhost", show: bool = False):
         title=TITLE,
         liveness=True,
         verbose=False,
+        # an upload travels base64-encoded in one websocket message: room for the largest file
+        # the readers take (20 MB → 27 MB), so a file just over it gets its message, not a
+        # closed session
+        websocket_max_message_size=UPLOAD_MESSAGE_BYTES,
     )
     host = "localhost" if address in ("0.0.0.0", "::", "") else address
     print(f"Bushing Explorer: http://{host}:{server.port}/", flush=True)

@@ -83,11 +83,11 @@ class MeasuredView(PlotView):
     # uploads run in the session: a bad file only sets a message
 
     def _on_stiffness_file(self, event):
-        if event.new:
+        if event.new is not None:  # an empty file too: it gets its message
             self.state.load_measured(event.new, self.stiffness_file.filename or "stiffness file")
 
     def _on_loop_file(self, event):
-        if event.new:
+        if event.new is not None:  # an empty file too: it gets its message
             self.state.load_measured_loop(event.new, self.loop_file.filename or "loop file")
 
     def _load_example(self, _event):

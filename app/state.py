@@ -24,7 +24,7 @@ from core.data import (
     parse_loop,
     parse_stiffness,
 )
-from core.design import as_dict
+from core.design import SIZE_RANGE, as_dict
 from core.fit import FitResult, fit_global, fit_two_step, gap
 
 from . import curves, units
@@ -167,7 +167,7 @@ class ExplorerState(param.Parameterized):
             try:  # the core's own rule for this field alone (cross-field rules below)
                 if name in MATERIAL_FIELDS:
                     Material(**{**as_dict(self.design.material), key: values[key]})
-                elif values[key] <= 0:
+                elif not SIZE_RANGE[0] <= values[key] <= SIZE_RANGE[1]:  # this field alone
                     Geometry(**{**as_dict(self.design.geometry), key: values[key]})
             except DesignError as exc:
                 errors[name] = _plain(exc)
@@ -228,6 +228,16 @@ class ExplorerState(param.Parameterized):
             return False
         data, (f, amp, _) = read
         x = float(self.display_amplitude(amp))
+        lo, hi = self.amplitude_bounds
+        problem = None
+        if not FREQUENCY_BOUNDS[0] <= f <= FREQUENCY_BOUNDS[1]:
+            problem = f"its frequency {f:.3g} Hz is outside {FREQUENCY_BOUNDS[0]:g}–{FREQUENCY_BOUNDS[1]:g} Hz"
+        elif not lo <= x <= hi:
+            problem = (f"its amplitude {x:.3g} {self.amplitude_unit} is outside this bushing's amplitude axis "
+                       f"({lo:.3g}–{hi:.3g} {self.amplitude_unit})")
+        if problem:
+            self.data_message = f"{filename}: {problem}; not loaded"
+            return False
         self.param.update(measured_loop=data, fit_result=None,
                           frequency_hz=float(np.clip(f, *FREQUENCY_BOUNDS)), amplitude=float(f"{x:.4g}"))
         return True

@@ -30,6 +30,8 @@ from typing import Any
 
 MODES = ("axial", "torsion")
 SIZE_RANGE = (1e-6, 1e3)  # m: radii and lengths from a micrometre to a kilometre, no further
+MAX_MODULUS = 1e12  # Pa: µ, m and σ_fmax at most 1 TPa (diamond's shear modulus is about half that)
+STRAIN_HALF_RANGE = (1e-9, 10.0)  # ε½: the range the fit searches
 MAX_DESIGN_BYTES = 1_000_000  # a design file is a few hundred bytes; one of a megabyte is not one
 
 
@@ -103,8 +105,15 @@ class Material:
                 value = _number(key, value)
                 if not 0.0 < value <= 1.0:
                     raise DesignError(key, f"must lie in (0, 1], got {value!r}")
+            elif f.name == "friction_strain_half":
+                value = _positive(key, value)
+                if not STRAIN_HALF_RANGE[0] <= value <= STRAIN_HALF_RANGE[1]:
+                    raise DesignError(key, f"must lie between {STRAIN_HALF_RANGE[0]:g} and {STRAIN_HALF_RANGE[1]:g}, "
+                                      f"got {value!r}")
             else:
                 value = _positive(key, value)
+                if value > MAX_MODULUS:
+                    raise DesignError(key, f"must be at most {MAX_MODULUS:g} Pa, got {value!r}")
             object.__setattr__(self, f.name, value)
 
 

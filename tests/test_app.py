@@ -557,3 +557,30 @@ def test_changes_add_no_styles_and_no_options_entries(app):
         app.state.amplitude = 0.05 + 0.01 * i
     assert plots._template.cache_info().currsize == templates
     assert len(hv.Store.custom_options()) == entries
+
+
+def test_hostile_values_from_the_page_leave_a_message_or_nothing(app, caplog):
+    """Values a hostile page (or a slip) sends: a message beside the field, or nothing moves;
+    no traceback in the log, the session goes on."""
+    slider = app.inputs.amplitude.slider
+    before = app.state.amplitude
+    slider.value = 400.0  # 10^400 mm: beyond any float
+    assert app.state.amplitude == pytest.approx(app.state.amplitude_bounds[1], rel=1e-3)
+    slider.value = float("nan")
+    assert np.isfinite(app.state.amplitude)
+    app.state.amplitude = before
+    app.state.friction_strain_half = 1e-300
+    assert "friction_strain_half" in app.state.errors and app.state.design == PAPER_B
+    app.state.length_mm = 1e308
+    assert "length_mm" in app.state.errors
+    app.state.param.update(friction_strain_half=0.004, length_mm=90.0)
+    assert app.state.errors == {}
+    t = np.linspace(0, 10, 400, endpoint=False)
+    tiny = "time_s,displacement,force\n" + "".join(
+        f"{ti},{1e-16 * np.sin(2 * np.pi * 0.1 * ti)},{np.sin(2 * np.pi * 0.1 * ti)}\n" for ti in t)
+    assert not app.state.load_measured_loop(tiny, "tiny.csv")
+    assert "outside this bushing's amplitude axis" in app.state.data_message
+    app.tabs.active = 3
+    app.measured.stiffness_file.value = b""  # an empty file: its own message, not the last one
+    assert app.state.data_message == "stiffness file: stiffness file is empty" or "empty" in app.state.data_message
+    assert not [r for r in caplog.records if r.exc_info]
