@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
+from app.deploy import nginx_config
 from tests.helpers import free_port, wait_for
 
-ROOT = Path(__file__).resolve().parents[1]
 NGINX = shutil.which("nginx") or ("/usr/sbin/nginx" if Path("/usr/sbin/nginx").exists() else None)
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
@@ -27,12 +27,7 @@ def balanced(tmp_path):
     procs = [subprocess.Popen([sys.executable, "-m", "app.cli", "serve", "--port", str(p), "--address", "127.0.0.1"],
                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env={**os.environ, **env})
              for p in backs]
-    conf = (ROOT / "deploy" / "nginx.conf.template").read_text()
-    for key, value in {"pid": tmp_path / "nginx.pid", "error_log": tmp_path / "error.log",
-                       "access_log": tmp_path / "access.log", "temp": tmp_path, "port": front,
-                       "servers": "\n".join(f"        server 127.0.0.1:{p};" for p in backs)}.items():
-        conf = conf.replace("{" + key + "}", str(value))
-    (tmp_path / "nginx.conf").write_text(conf)
+    (tmp_path / "nginx.conf").write_text(nginx_config(front, backs, tmp_path))
     nginx = subprocess.Popen([NGINX, "-c", str(tmp_path / "nginx.conf"), "-p", str(tmp_path), "-g", "daemon off;"],
                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     try:
