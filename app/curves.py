@@ -19,9 +19,11 @@ from core.bushing import (
     loop,
     material_model,
     stiffness,
+    stiffness_points,
     strain_factor,
 )
 from core.data import MeasuredLoop, MeasuredStiffness, loss_factor, magnitude_residual_pct
+from core.fit import gap
 from core.material import ConvergenceError
 
 from . import units
@@ -171,6 +173,14 @@ def measured_points(measured: MeasuredStiffness | None, mode: str) -> dict | Non
             "amplitude": units.display_amplitude(measured.amplitude, mode),
             "magnitude": units.display_stiffness(measured.magnitude, mode),
             "loss_factor": measured.loss_factor}
+
+
+def measured_residuals(design: Design, measured: MeasuredStiffness) -> dict:
+    """``design`` at each measured point against the data: |K| in %, the loss factor, the gap."""
+    k = stiffness_points(design, measured.frequency_hz, measured.amplitude)
+    return {"magnitude_residual_pct": magnitude_residual_pct(k, measured.stiffness),
+            "loss_factor_residual": loss_factor(k) - measured.loss_factor,
+            "gap": gap(k, measured.stiffness)}
 
 
 def measured_loop_points(measured_loop: MeasuredLoop | None, mode: str) -> dict | None:

@@ -14,7 +14,7 @@ from core.diagnose import BIC_THRESHOLD
 from core.effects import EFFECTS
 from core.material import ConvergenceError
 
-from . import curves, plots
+from . import plots
 from .diagnosis_state import DiagnosisState
 from .live import LivePlot, update_or_keep
 from .units import amplitude_unit
@@ -78,7 +78,7 @@ class DiagnosisView(pn.viewable.Viewer):
         self.download_predictions = pn.widgets.FileDownload(
             callback=lambda: io.StringIO(state.predictions_csv()), filename="bushing-predictions.csv",
             label="Predictions (CSV)", disabled=True)
-        self.gap = self.curve_plots = self.maps = None
+        self.live: dict[str, LivePlot] = {}  # "gap", "curves", "maps": built with the first result
         self._plot_holders = {name: pn.Column(sizing_mode="stretch_width") for name in ("gap", "curves", "maps")}
         self._results = pn.Column(
             "### 3. What the diagnosis found",
@@ -201,37 +201,19 @@ class DiagnosisView(pn.viewable.Viewer):
         return "\n\n".join(lines)
 
     def _draw(self, r):
-        mode = r.final.design.mode
-        dims = plots.dimensions(mode)
-        stages = curves.gap_stages(r)
-        dims["gap"].range = (0.0, 1.1 * max(float(np.max(stages["gap"])), stages["noise"] or 0.0))
-        groups = curves.curve_groups(r)
+        overlays = plots.diagnosis_overlays(r)
         palette = plots.SWEEP_PALETTES["amplitude"]
-        unit = amplitude_unit(mode)
+        unit = amplitude_unit(r.final.design.mode)
         self.curve_key.object = "Amplitudes: " + " ".join(
             f'<span style="color:{palette[i % len(palette)]};font-weight:bold">■ {plots.sweep_label(g["amplitude"], unit)}</span>'
-            for i, g in enumerate(groups))
-        for i, quantity in enumerate(("magnitude", "loss_factor")):  # the data and both models in view
-            dims[quantity].range = curves.padded([v for g in groups for v in (g["data"][i], g["baseline"][i], g["final"][i])])
-        base, final = curves.misfit_points(r, "baseline"), curves.misfit_points(r, "final")
-        dims["amplitude"].range = curves.padded([final["amplitude"]], log=True)
-        maps = []
-        for which, m in (("baseline", base), ("final", final)):
-            for column, name in (("magnitude_pct", "|K| misfit (%)"), ("loss_factor", "loss-factor misfit")):
-                limit = float(np.max(np.abs(base[column]))) or 1.0  # one colour scale for before and after
-                maps.append(plots.misfit_map(m, column, f"{which.capitalize()}: {name}", dims, limit,
-                                             f"bushing-misfit-{which}-{plots.MISFIT_PNG[column]}"))
-        curve_overlays = plots.diagnosis_curves(groups, dims)
-        shown = {"gap": ([plots.gap_bars(stages, dims)], 1), "curves": (list(curve_overlays.values()), 2),
-                 "maps": (maps, 2)}
-        for name, (items, cols) in shown.items():
-            live = getattr(self, name if name != "curves" else "curve_plots")
+            for i, g in enumerate(overlays["groups"]))
+        for name, cols in (("gap", 1), ("curves", 2), ("maps", 2)):
+            live = self.live.get(name)
             if live is None:
-                live = LivePlot(items)
-                setattr(self, name if name != "curves" else "curve_plots", live)
+                self.live[name] = live = LivePlot(overlays[name])
                 self._plot_holders[name].objects = [live.grid(cols)]
             else:
-                live.show(items)
+                live.show(overlays[name])
 
     def __panel__(self):
         return pn.Column(

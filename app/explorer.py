@@ -27,8 +27,6 @@ class ExplorerPlots(PlotView):
                                     margin=(0, 10))
         self.loop: LivePlot | None = None
         self.grid: LivePlot | None = None
-        self.dims: dict = {}
-        self._mode = None
         self._sweeps, self._sweeps_key = {}, None
         self._update()  # built outside a held document: held, the new panes are laid out wrong
 
@@ -44,8 +42,7 @@ class ExplorerPlots(PlotView):
     def _update(self):
         s = self.state
         data = s.explorer_data()
-        if data.mode != self._mode:
-            self.dims, self._mode = plots.dimensions(data.mode), data.mode  # new units: new axes
+        self.dims_for(data.mode)  # new units: new axes
         key = (s.design, s.freq_range)
         if key != self._sweeps_key:  # the sweeps change with the design, not the operating point
             labels = plots.explorer_labels(data)

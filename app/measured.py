@@ -134,8 +134,7 @@ class MeasuredView(PlotView):
 
     def _draw(self, points, residuals):
         mode = self.state.design.mode
-        if mode != getattr(self, "_mode", None):
-            self.dims, self._mode = plots.dimensions(mode), mode
+        self.dims_for(mode)
         if points is not None:  # plots of the same quantity share the axis: one range for both
             self.dims["residual_magnitude"].range = padded([residuals["magnitude_residual_pct"]])
             self.dims["residual_loss"].range = padded([residuals["loss_factor_residual"]])

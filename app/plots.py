@@ -33,7 +33,7 @@ import numpy as np
 from bokeh.models import SaveTool
 
 from core import Design
-from core.data import MeasuredStiffness, loss_factor, magnitude_residual_pct
+from core.data import MeasuredStiffness
 
 from . import curves, units
 
@@ -349,6 +349,7 @@ def loop_shape_overlay(lp: dict, dims: dict, title: str = "Loop shape during the
     x = lp["displacement"] / np.max(np.abs(lp["displacement"]))
     peak = np.max(np.abs(lp["force"]))
     xd, fd = dims["drive_rel"], dims["force_rel"]
+    xd.range, fd.range = (-1.05, 1.05), (-1.1, 1.1)  # scaled to ±1: the same axes for every loop
     items = [_curve(x, lp["force"] / peak, xd, fd, "total", color="black", line_width=2.5)]
     items += [_curve(x, lp[f"force_{name}"] / peak, xd, fd, name, color=color, line_width=1.5)
               for name, color in BRANCH_COLORS.items()]
@@ -361,7 +362,6 @@ def branch_plots(design: Design, frequency_hz: float = 10.0, amplitude: float | 
     ``amplitude`` (display units)."""
     at = amplitude if amplitude is not None else float(curves.fletcher_gent_amplitudes(design)[2])
     dims = dimensions(design.mode)
-    dims["drive_rel"].range, dims["force_rel"].range = (-1.05, 1.05), (-1.1, 1.1)
     overlays = branch_overlays(curves.branch_breakdown(design, frequency_hz, curves.amplitude_grid(design, n)), dims, at)
     shape = loop_shape_overlay(curves.hysteresis_loop(design, frequency_hz, at), dims)
     return sized(hv.Layout([*overlays.values(), shape]).cols(1), width)
@@ -390,11 +390,7 @@ def residual_overlays(points: dict | None, residuals: dict | None, dims: dict) -
 
 def residual_plots(design: Design, measured: MeasuredStiffness, *, width: int | None = 500) -> hv.Layout:
     """The residuals of ``design`` against measured stiffness."""
-    from core.bushing import stiffness_points
-
-    k = stiffness_points(design, measured.frequency_hz, measured.amplitude)
-    residuals = {"magnitude_residual_pct": magnitude_residual_pct(k, measured.stiffness),
-                 "loss_factor_residual": loss_factor(k) - measured.loss_factor}
+    residuals = curves.measured_residuals(design, measured)
     overlays = residual_overlays(curves.measured_points(measured, design.mode), residuals, dimensions(design.mode))
     return sized(hv.Layout(list(overlays.values())).cols(2), width)
 
@@ -448,17 +444,31 @@ def misfit_map(m: dict, column: str, title: str, dims: dict, limit: float, png: 
     return _overlay([pts], title, png, logy=True, legend=None, height=260)
 
 
+def diagnosis_overlays(diagnosis) -> dict:
+    """The plots of a :class:`core.diagnose.Diagnosis`: ``"gap"`` (one plot: the gap after each
+    step), ``"curves"`` (|K| and the loss factor: data, baseline, final model) and ``"maps"``
+    (the misfit before, then after: |K| and the loss factor each, on one colour scale per
+    quantity); ``"groups"`` the curves' amplitude groups (:func:`app.curves.curve_groups`)."""
+    dims = dimensions(diagnosis.final.design.mode)
+    stages = curves.gap_stages(diagnosis)
+    dims["gap"].range = (0.0, 1.1 * max(float(np.max(stages["gap"])), stages["noise"] or 0.0))
+    groups = curves.curve_groups(diagnosis)
+    for i, quantity in enumerate(("magnitude", "loss_factor")):  # the data and both models in view
+        dims[quantity].range = curves.padded([v for g in groups for v in (g["data"][i], g["baseline"][i], g["final"][i])])
+    base, final = curves.misfit_points(diagnosis, "baseline"), curves.misfit_points(diagnosis, "final")
+    dims["amplitude"].range = curves.padded([final["amplitude"]], log=True)
+    maps = []
+    for which, m in (("baseline", base), ("final", final)):
+        for column, name in (("magnitude_pct", "|K| misfit (%)"), ("loss_factor", "loss-factor misfit")):
+            limit = float(np.max(np.abs(base[column]))) or 1.0  # one colour scale for before and after
+            maps.append(misfit_map(m, column, f"{which.capitalize()}: {name}", dims, limit,
+                                   f"bushing-misfit-{which}-{MISFIT_PNG[column]}"))
+    return {"gap": [gap_bars(stages, dims)], "curves": list(diagnosis_curves(groups, dims).values()),
+            "maps": maps, "groups": groups}
+
+
 def diagnosis_plots(diagnosis, *, width: int | None = 560) -> hv.Layout:
     """A :class:`core.diagnose.Diagnosis`: the gap after each step, the data against the
     baseline and the final model, and the misfit maps before and after."""
-    mode = diagnosis.final.design.mode
-    dims = dimensions(mode)
-    items = [gap_bars(curves.gap_stages(diagnosis), dims)]
-    items += list(diagnosis_curves(curves.curve_groups(diagnosis), dims).values())
-    base, final = curves.misfit_points(diagnosis, "baseline"), curves.misfit_points(diagnosis, "final")
-    for column, name in (("magnitude_pct", "|K| misfit (%)"), ("loss_factor", "loss-factor misfit")):
-        limit = float(np.max(np.abs(base[column]))) or 1.0
-        for which, m in (("baseline", base), ("final", final)):
-            items.append(misfit_map(m, column, f"{which.capitalize()}: {name}", dims, limit,
-                                    f"bushing-misfit-{which}-{MISFIT_PNG[column]}"))
-    return sized(hv.Layout(items).cols(2), width)
+    overlays = diagnosis_overlays(diagnosis)
+    return sized(hv.Layout(overlays["gap"] + overlays["curves"] + overlays["maps"]).cols(2), width)

@@ -36,8 +36,7 @@ class SlicesView(PlotView):
     def _update(self):
         data = self.state.slice_comparison()
         mode = self.state.design.mode
-        if mode != getattr(self, "_mode", None):
-            self.dims, self._mode = plots.dimensions(mode), mode
+        self.dims_for(mode)
         self.dims["amplitude"].range = padded([data["amplitude"]], log=True)
         overlays = plots.slices_overlays(data, self.dims, self.state.amplitude)
         items = [overlays[w] for w in WHICH]

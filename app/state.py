@@ -14,18 +14,16 @@ import numpy as np
 import param
 
 from core import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material
-from core.bushing import stiffness, stiffness_points, strain_factor
+from core.bushing import stiffness, strain_factor
 from core.data import (
     DataError,
     MeasuredLoop,
     MeasuredStiffness,
-    loss_factor,
-    magnitude_residual_pct,
     parse_loop,
     parse_stiffness,
 )
 from core.design import SIZE_RANGE, as_dict
-from core.fit import FitResult, fit_global, fit_two_step, gap
+from core.fit import FitResult, fit_global, fit_two_step
 
 from . import curves, units
 from .units import FREQUENCY_BOUNDS
@@ -301,15 +299,7 @@ class ExplorerState(param.Parameterized):
 
     def measured_residuals(self) -> dict | None:
         """The design at each measured point against the data: |K| in %, the loss factor, the gap."""
-        d = self.measured
-        if d is None:
-            return None
-        k_model = stiffness_points(self.design, d.frequency_hz, d.amplitude)
-        return {
-            "magnitude_residual_pct": magnitude_residual_pct(k_model, d.stiffness),
-            "loss_factor_residual": loss_factor(k_model) - d.loss_factor,
-            "gap": gap(k_model, d.stiffness),
-        }
+        return None if self.measured is None else curves.measured_residuals(self.design, self.measured)
 
     def measured_loop_points(self) -> dict | None:
         return curves.measured_loop_points(self.measured_loop, self.design.mode)
@@ -351,9 +341,6 @@ class ExplorerState(param.Parameterized):
     def display_amplitude(self, x_si):
         """An amplitude in SI (m or rad) in the display unit (mm or rad)."""
         return units.display_amplitude(x_si, self.design.mode)
-
-    def _stiffness_display(self, k):
-        return units.display_stiffness(k, self.design.mode)
 
     @property
     def freq_range(self) -> tuple[float, float]:

@@ -57,9 +57,7 @@ class TeachingView(PlotView):
     def _update(self):
         d = self.state.branch_breakdown()
         mode = self.state.design.mode
-        if mode != getattr(self, "_mode", None):
-            self.dims, self._mode = plots.dimensions(mode), mode
-            self.dims["drive_rel"].range, self.dims["force_rel"].range = (-1.05, 1.05), (-1.1, 1.1)
+        self.dims_for(mode)
         totals = {which: sum(d[which].values()) for which in WHICH}
         self.dims["amplitude"].range = padded([d["amplitude"]], log=True)
         self.dims["real"].range = padded([np.zeros(1), totals["real"]])

@@ -7,6 +7,7 @@ import numpy as np
 import panel as pn
 import param
 
+from . import plots
 from .live import update_or_keep
 from .state import ExplorerState
 from .units import OPERATING_FREQUENCIES
@@ -21,7 +22,16 @@ class PlotView(pn.viewable.Viewer):
     def __init__(self, state: ExplorerState, **params):
         self._shown = True
         self._stale = False
+        self._mode = None
+        self.dims: dict = {}
         super().__init__(state=state, **params)
+
+    def dims_for(self, mode: str) -> dict:
+        """The view's dimensions (:func:`app.plots.dimensions`): kept while the mode is, so that
+        the ranges set on them are the plots'; new with new units."""
+        if mode != self._mode:
+            self.dims, self._mode = plots.dimensions(mode), mode
+        return self.dims
 
     def changed(self):
         if self._shown:

@@ -189,7 +189,7 @@ def _finite(columns: dict) -> dict:
     formulas can represent, never a column of NaN)."""
     for name, values in columns.items():
         if not np.all(np.isfinite(np.asarray(values, dtype=float))):
-            raise ComputationError(f"bushing: the {name} is not a finite number for this design and drive "
+            raise ComputationError(f"the {name} is not a finite number for this design and drive "
                                    "(outside what the formulas can represent)")
     return columns
 
@@ -252,7 +252,7 @@ def _one_line_errors():
     except (DesignError, DataError, ValueError) as exc:
         _fail(f"bushing: {exc}", 2)
     except (ConvergenceError, ComputationError) as exc:
-        _fail(f"bushing: {exc}" if isinstance(exc, ConvergenceError) else str(exc), 1)
+        _fail(f"bushing: {exc}", 1)
     except KeyboardInterrupt:
         _fail("bushing: interrupted", 130)
     except Exception as exc:  # noqa: BLE001 - the last guard: one line, never a traceback

@@ -46,27 +46,27 @@ class Effect:
     branch: bool = False  # one of the thesis' own branches (parameters live in `material`)
     requires: tuple[str, ...] = ()  # acts only on one of these (branches or effects)
     excludes: tuple[str, ...] = ()  # cannot be combined with these effects
-    # a material-level effect's frequency-domain term: (material, its parameters, f in Hz, ε̂)
-    # → (the branch it enters, what it adds to that branch's modulus µ_eq, in Pa). The one
+    # a material-level effect's frequency-domain term: (material, its parameters, f in Hz, ε̂,
+    # the thesis' own branch moduli) → (the branch it enters, what it adds to that branch's
+    # modulus µ_eq, in Pa). The one
     # source of the effect's physics for the closed-form route: the equivalent modulus, the
     # branch-by-branch stiffness and the loop's branch amplitudes are derived from it.
     term: Callable[..., tuple[str, Any]] | None = None
 
 
-def _stiffening_term(material, p, f, eps):
+def _stiffening_term(material, p, f, eps, _base):
     """σ_el = 2µε(1 + βε²): its first harmonic at ε = ε̂ sin ωt is 2µ(1 + ¾βε̂²) ε̂."""
     return "elastic", material.shear_modulus * 0.75 * p["stiffening"] * eps**2
 
 
-def _viscous_term(_material, p, f, _eps):
+def _viscous_term(_material, p, f, _eps, _base):
     """σ = c dε/dt: µ_eq += iωc / 2."""
     return "viscoelastic", 1j * np.pi * f * p["viscosity"]
 
 
-def _rate_term(material, p, f, eps):
+def _rate_term(_material, p, f, _eps, base):
     """µ_f(ε̂) (f / 10 Hz)^γ in place of µ_f(ε̂)."""
-    mu_f = friction_modulus(eps, material.friction_stress_max, material.friction_strain_half)
-    return "friction", mu_f * ((f / REFERENCE_FREQUENCY_HZ) ** p["rate_exponent"] - 1.0)
+    return "friction", base["friction"] * ((f / REFERENCE_FREQUENCY_HZ) ** p["rate_exponent"] - 1.0)
 
 
 EFFECTS: dict[str, Effect] = {
@@ -217,15 +217,16 @@ def branch_moduli(material: Material, effects: Mapping, frequency_hz, strain_amp
     f = np.asarray(frequency_hz, dtype=float)
     eps = np.asarray(strain_amplitude, dtype=float)
     zeros = np.zeros(np.broadcast_shapes(f.shape, eps.shape), dtype=complex)
-    out = {
+    base = {
         "elastic": material.shear_modulus + zeros,
         "viscoelastic": fractional_modulus(f, material.fractional_coefficient, material.fractional_order) + zeros,
         "friction": friction_modulus(eps, material.friction_stress_max, material.friction_strain_half) + zeros,
     }
+    out = dict(base)
     for eid, params in effects.items():
         term = EFFECTS[eid].term
         if term is not None:
-            branch, value = term(material, params, f, eps)
+            branch, value = term(material, params, f, eps, base)
             out[branch] = out[branch] + value
     return out
 

@@ -53,13 +53,13 @@ def test_a_diagnosis_in_the_tab_holds_the_core_numbers(app):
     assert f"mass = {r.steps[0].parameters['mass']:.4g} ± {r.steps[0].standard_errors['mass']:.2g}" in view.report.object
     assert "What is left is noise" in view.report.object
     # the gap bars: the baseline's and after each step; the noise line
-    gap = view.gap.current[0]
+    gap = view.live["gap"].current[0]
     bars = gap.get(0)
     assert list(bars.dimension_values(0)) == ["baseline", "+ inertia"]
     np.testing.assert_allclose(bars.dimension_values(1), [r.baseline.gap, r.steps[0].gap_after])
     assert gap.get(1).data == pytest.approx(r.noise_gap)  # the noise line
     # the final model's curve at 0.1 mm is the core's stiffness of the final design, in kN/mm
-    magnitude, loss = view.curve_plots.current
+    magnitude, loss = view.live["curves"].current
     f, k = xy(magnitude, "0.1 mm final")
     np.testing.assert_allclose(k, np.abs(stiffness_points(r.final.design, f, 0.1e-3)) / 1e6, rtol=1e-12)
     # each curve plot's axis takes in the data and both models' curves
@@ -68,7 +68,7 @@ def test_a_diagnosis_in_the_tab_holds_the_core_numbers(app):
         low, high = element(ov, "0.1 mm final").vdims[0].range
         assert low < y.min() and y.max() < high
     # the misfit map: model − data in % of |K|, the amplitude in mm
-    final_map = view.maps.current[2]
+    final_map = view.live["maps"].current[2]
     points = final_map.get(0)
     d = state.data
     expected = 100 * (np.abs(stiffness_points(r.final.design, d.frequency_hz, d.amplitude)) / d.magnitude - 1)
