@@ -174,9 +174,11 @@ class DiagnosisView(pn.viewable.Viewer):
             f"**Baseline** ({branches}): gap **{r.baseline.gap:.4f}**; the noise alone gives about {noise}.",
             f"*Where it disagrees:* {r.where_baseline}",
         ]
+        vague = set(r.final.fit.undetermined)
         for n, step in enumerate(r.steps, 1):
             params = ", ".join(f"{k} = {v:.4g}" + (f" ± {step.standard_errors[k]:.2g}"
-                                                   if np.isfinite(step.standard_errors.get(k, np.nan)) else "")
+                                                   if np.isfinite(step.standard_errors.get(k, np.nan)) else
+                                                   " (not determined)" if EFFECTS[step.effect].fitting_name(k) in vague else "")
                                for k, v in step.parameters.items()) or "no parameters"
             partner = step.extra.get("found_with")
             together = f" (found together with {partner})" if partner else ""
@@ -194,6 +196,8 @@ class DiagnosisView(pn.viewable.Viewer):
                          f"explains: {r.where_remaining}")
         else:
             lines.append(f"**What is left is noise**: final gap {r.final.gap:.4f}.")
+        for warning in r.final.fit.warnings:
+            lines.append(f"⚠ {warning}")
         if r.held_out:
             h = r.held_out
             lines.append(f"**On held-out data** ({h['left_out']}, each refitted without it): gap "

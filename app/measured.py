@@ -147,19 +147,24 @@ class MeasuredView(PlotView):
 
     @staticmethod
     def _results_table(r):
-        rows = ["| parameter | fitted | ± standard error |", "|---|---|---|"]
+        vague = set(r.undetermined)
+        rows = ["| parameter | fitted | ± standard error | 95 % interval (profile) |", "|---|---|---|---|"]
         for p in PARAMETERS:
             sym, scale, unit = LABELS[p]
             value, err = getattr(r.design.material, p) / scale, r.standard_errors[p] / scale
-            rows.append(f"| {sym} ({unit or '–'}) | {value:.5g} | {err:.2g} |")
+            err = "–" if p in vague or not np.isfinite(err) else f"{err:.2g}"
+            ends = ["not bounded" if e is None else f"{e / scale:.3g}" for e in r.intervals.get(p, ())]
+            interval = " – ".join(ends) + (" **not determined**" if p in vague else "") or "–"
+            rows.append(f"| {sym} ({unit or '–'}) | {value:.5g} | {err} | {interval} |")
         gap = f"{r.gap:.4f}" if np.isfinite(r.gap) else "–"
         loop = f", loop RMS misfit {r.loop_rms:.4f}" if r.loop_rms is not None else ""
         corr = ["| | " + " | ".join(LABELS[p][0] for p in PARAMETERS) + " |",
                 "|---" * (len(PARAMETERS) + 1) + "|"]
         for a in PARAMETERS:
             corr.append(f"| {LABELS[a][0]} | " + " | ".join(f"{r.correlation[a][b]:+.2f}" for b in PARAMETERS) + " |")
+        warnings = "".join(f"\n\n⚠ {w}" for w in r.warnings)
         return (f"### Fitted ({r.method})\n\nGap (relative RMS misfit of complex stiffness): **{gap}**{loop}; "
-                f"{r.points} points, {r.starts} starts.\n\n" + "\n".join(rows)
+                f"{r.points} points, {r.starts} starts.{warnings}\n\n" + "\n".join(rows)
                 + "\n\n**Correlation between parameters**\n\n" + "\n".join(corr))
 
     def __panel__(self):
@@ -169,7 +174,8 @@ class MeasuredView(PlotView):
                 "files (drop a file on a button or click it; the formats are in the About tab), or the "
                 "synthetic example. The points appear over the model in the Explorer tab; the "
                 "residuals are below. **Fit** identifies µ, m, α, σ_fmax and ε½ with standard "
-                "errors; then take the fitted design into the explorer or save it.",
+                "errors and 95 % intervals, and says which parameters the data cannot determine; "
+                "then take the fitted design into the explorer or save it.",
                 sizing_mode="stretch_width"),
             pn.Row(pn.Column("**Stiffness CSV**", self.stiffness_file, sizing_mode="stretch_width"),
                    pn.Column("**Loop CSV** (optional)", self.loop_file, sizing_mode="stretch_width"),

@@ -273,6 +273,8 @@ def _cmd_fit(args) -> None:
     loop_data = read_loop(args.loop) if args.loop else None
     result = fit_global(design, data, loop_data)
     _write_text(result.to_json(), args.output)
+    for line in result.warnings:  # the fit succeeded; what the user must know, one line each
+        sys.stderr.write(f"bushing fit: warning: {line}\n")
 
 
 def _cmd_diagnose(args) -> None:

@@ -53,6 +53,11 @@ class Effect:
     # branch-by-branch stiffness and the loop's branch amplitudes are derived from it.
     term: Callable[..., tuple[str, Any]] | None = None
 
+    def fitting_name(self, parameter: str) -> str:
+        """A parameter's name in fits and their reports: a branch's parameters are the
+        material's, an added effect's are ``effect_id.name``."""
+        return parameter if self.branch else f"{self.id}.{parameter}"
+
 
 def _stiffening_term(material, p, f, eps, _base):
     """σ_el = 2µε(1 + βε²): its first harmonic at ε = ε̂ sin ωt is 2µ(1 + ¾βε̂²) ε̂."""

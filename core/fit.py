@@ -16,10 +16,14 @@ Two procedures:
 Standard errors come from the Jacobian at the optimum, cov = s² (JᵀJ)⁻¹ with s² the residual
 variance, carried to the natural parameters by the delta method; the correlation matrix is that
 of the fitted (log) parameters, which the monotone transforms leave unchanged to first order.
+They are only the curvature at the optimum: the 95 % intervals come from the profile of each
+parameter (:mod:`core.uncertainty`), and a parameter whose profile stays flat to the end of its
+fitting range is reported as not determined by the data (its standard error null).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from collections.abc import Mapping, Sequence
@@ -32,6 +36,7 @@ from .bushing import check_strain, loop_force, stiffness_points
 from .data import MeasuredLoop, MeasuredStiffness
 from .design import Design, as_dict
 from .effects import EFFECTS, Parameter
+from .uncertainty import CONFIDENCE, profile
 
 PARAMETERS = (
     "shear_modulus",
@@ -105,21 +110,38 @@ class FitResult:
     starts: int = 1
     loop_rms: float | None = None  # relative RMS force misfit of the loop, if one was fitted
     history: list = field(default_factory=list)
+    # profile-likelihood intervals at CONFIDENCE, natural units; None for a side the data do not
+    # bound within the fitting range (empty if the fit was not profiled)
+    intervals: dict[str, tuple[float | None, float | None]] = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
+
+    @property
+    def undetermined(self) -> list[str]:
+        """The parameters the data do not determine: their interval is open on a side."""
+        return [k for k, (lo, hi) in self.intervals.items() if lo is None or hi is None]
 
     def report(self) -> dict:
         """The ``fit`` object of the fitted design file (docs/files.md). A number the data do
-        not define (a standard error or correlation of a degenerate fit) is null."""
+        not define (a standard error or correlation of a degenerate fit, the standard error of
+        an undetermined parameter) is null."""
         def finite(v):
             return float(v) if v is not None and math.isfinite(v) else None
 
+        vague = set(self.undetermined)
         out = {
-            "standard_errors": {k: finite(v) for k, v in self.standard_errors.items()},
+            "standard_errors": {k: None if k in vague else finite(v) for k, v in self.standard_errors.items()},
             "correlation": {a: {b: finite(v) for b, v in row.items()} for a, row in self.correlation.items()},
             "gap": finite(self.gap),
             "points": self.points,
             "method": self.method,
             "starts": self.starts,
         }
+        if self.intervals:
+            out["confidence"] = CONFIDENCE
+            out["intervals"] = {k: [finite(lo), finite(hi)] for k, (lo, hi) in self.intervals.items()}
+            out["undetermined"] = self.undetermined
+        if self.warnings:
+            out["warnings"] = list(self.warnings)
         if self.loop_rms is not None:
             out["loop_rms"] = self.loop_rms
         return out
@@ -176,7 +198,7 @@ class _Problem:
         return np.concatenate(parts)
 
 
-def _uncertainties(problem: _Problem, sol) -> tuple[dict, dict]:
+def _uncertainties(problem: _Problem, sol) -> tuple[dict, dict, np.ndarray]:
     n, p = sol.fun.size, len(problem.free)
     dof = max(n - p, 1)
     s2 = 2.0 * sol.cost / dof
@@ -194,7 +216,7 @@ def _uncertainties(problem: _Problem, sol) -> tuple[dict, dict]:
         corr = cov / np.outer(sd, sd)
     correlation = {a: {b: float(np.round(corr[i, j], 12)) for j, b in enumerate(problem.free)}
                    for i, a in enumerate(problem.free)}
-    return errors, correlation
+    return errors, correlation, sd
 
 
 def _starts(problem: _Problem, n: int, seed: int = 0) -> list[np.ndarray]:
@@ -246,9 +268,57 @@ def fitted_name(name: str | None) -> str | None:
     return f"{name} (fitted)"
 
 
-def _result(problem: _Problem, sol, method: str, starts: int, design: Design, errors=None, corr=None):
-    if errors is None:
-        errors, corr = _uncertainties(problem, sol)
+def _profiled(problem: _Problem, sol):
+    """Profile every free parameter; if the walk finds a lower misfit than the optimum (the
+    search was not global), refit from there and profile again. The solution, its intervals in
+    natural units and whether the profile finished in its time."""
+    lo, hi = problem.bounds()
+    for _ in range(3):
+        sd = _uncertainties(problem, sol)[2]
+        prof = profile(problem.residuals, sol.x, lo, hi, sd)
+        if prof.better is None:
+            break
+        moved = _solve(problem, [prof.better])
+        if moved.cost >= sol.cost:
+            break
+        sol = moved
+    intervals = {}
+    for name, spec, (a, b) in zip(problem.free, problem.specs, prof.intervals):
+        ends = [None if t is None else math.exp(t) if spec.log else float(t) for t in (a, b)]
+        intervals[name] = (ends[0], ends[1])
+    return sol, intervals, prof.complete
+
+
+def _warnings(problem: _Problem, sol, intervals: dict, complete: bool) -> tuple[str, ...]:
+    """Plain words for what the user must know about a fit: parameters driven to the end of
+    their fitting range, parameters the data do not determine, an unfinished profile."""
+    lo, hi = problem.bounds()
+    values = problem.values(sol.x)
+    out = []
+    for i, (name, spec) in enumerate(zip(problem.free, problem.specs)):
+        span = hi[i] - lo[i]
+        edge = "lower" if sol.x[i] - lo[i] <= 1e-6 * span else "upper" if hi[i] - sol.x[i] <= 1e-6 * span else None
+        if edge:
+            unit = "" if spec.unit == "–" else f" {spec.unit}"
+            out.append(f"{name} ran to the {edge} end of its fitting range ({values[name]:.3g}{unit}): "
+                       f"the model cannot follow these data there; check that the design's mode and "
+                       f"geometry are those of the measurement")
+    for name, (a, b) in intervals.items():
+        if (a is None or b is None) and not any(w.startswith(f"{name} ran to") for w in out):
+            unit = parameter(name).unit
+            unit = "" if unit == "–" else f" {unit}"
+            which = ("any value in its fitting range" if a is None and b is None
+                     else f"any value up to {b:.3g}{unit}" if a is None else f"any value from {a:.3g}{unit} up")
+            out.append(f"{name} is not determined by these data: {which} fits them as well "
+                       f"({CONFIDENCE:.0%} profile); measure more amplitudes or frequencies to pin it down")
+    if not complete:
+        out.append("the profile intervals are incomplete: the time limit stopped the walk (unfinished sides are open)")
+    return tuple(out)
+
+
+def _result(problem: _Problem, sol, method: str, starts: int, design: Design, intervals=None,
+            warnings=()) -> FitResult:
+    errors, corr, _ = _uncertainties(problem, sol)
     fitted = problem.model(sol.x)
     fitted = fitted.replace(name=fitted_name(design.name))
     g = float("nan")
@@ -260,19 +330,22 @@ def _result(problem: _Problem, sol, method: str, starts: int, design: Design, er
         f = sum(loop_force(fitted, problem.loop_f, problem.loop_amp, problem.loop_phase))
         loop_rms = float(np.sqrt(np.mean((f - problem.loop_force) ** 2)) / problem.loop_scale)
     n = 0 if problem.data is None else len(problem.data)
-    return FitResult(fitted, errors, corr, g, float(sol.cost), n, method, starts, loop_rms)
+    return FitResult(fitted, errors, corr, g, float(sol.cost), n, method, starts, loop_rms,
+                     intervals=intervals or {}, warnings=tuple(warnings))
 
 
 def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: MeasuredLoop | None = None,
                *, starts: int = 8, free: tuple[str, ...] = PARAMETERS, seed: int = 0,
-               initial: Sequence[Mapping[str, float]] = ()) -> FitResult:
+               initial: Sequence[Mapping[str, float]] = (), intervals: bool = True) -> FitResult:
     """Fit the parameters ``free`` of ``design`` to all the data at once.
 
     ``design`` gives the geometry, the mode and the starting values; ``data`` measured
     stiffness, ``loop`` a measured loop (at least one of the two). ``free`` names material
     parameters or effect parameters as ``effect_id.name``. The search starts from the design's
     values and ``starts − 1`` seeded points around them, or, if ``initial`` is given, from those
-    points (mappings of some free parameters' values, the rest the design's).
+    points (mappings of some free parameters' values, the rest the design's). With
+    ``intervals`` each parameter is profiled (:mod:`core.uncertainty`) for its interval, which
+    may also find a better optimum than the starts did.
     Returns a :class:`FitResult`.
     """
     if data is None and loop is None:
@@ -290,7 +363,10 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     else:
         points = _starts(problem, starts, seed)
     sol = _solve(problem, points)
-    return _result(problem, sol, "global", len(points), design)
+    if not intervals:
+        return _result(problem, sol, "global", len(points), design)
+    sol, found, complete = _profiled(problem, sol)
+    return _result(problem, sol, "global", len(points), design, found, _warnings(problem, sol, found, complete))
 
 
 def fit_two_step(design: Design, loop: MeasuredLoop, sweep: MeasuredStiffness,
@@ -303,11 +379,11 @@ def fit_two_step(design: Design, loop: MeasuredLoop, sweep: MeasuredStiffness,
     history = []
     for _ in range(rounds):
         step1 = fit_global(current, loop=loop, free=("shear_modulus", "friction_stress_max",
-                                                      "friction_strain_half"), starts=4)
+                                                      "friction_strain_half"), starts=4, intervals=False)
         step2 = fit_global(step1.design, data=sweep, free=("fractional_coefficient", "fractional_order"),
-                           starts=4)
+                           starts=4, intervals=False)
         current = step2.design
         history.append(as_dict(current.material))
     joint = fit_global(current, data=sweep, loop=loop, starts=1)
-    return FitResult(joint.design, joint.standard_errors, joint.correlation, joint.gap, joint.cost,
-                     joint.points, "two-step", 4, joint.loop_rms, [*history, as_dict(joint.design.material)])
+    return dataclasses.replace(joint, method="two-step", starts=4,
+                               history=[*history, as_dict(joint.design.material)])

@@ -4,6 +4,7 @@ against the core."""
 import csv
 import io
 import logging
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -347,6 +348,21 @@ def test_fit_in_the_app_and_take_it_into_the_explorer(app):
     assert app.state.measured_residuals()["gap"] == pytest.approx(r.gap, rel=1e-6)
     fitted = loads_design(app.measured._fitted_json().getvalue())
     assert fitted.material == r.design.material
+
+
+def test_a_fit_the_data_cannot_determine_says_so_in_the_app(app):
+    """The single-amplitude sweep: µ and ε½ are not determined; the table says so, shows no
+    standard error for them, the warnings are above the table."""
+    sweep = (Path(__file__).resolve().parent.parent / "examples" / "paper_b_sweep_0.1mm.csv").read_bytes()
+    assert app.state.load_measured(sweep, "paper_b_sweep_0.1mm.csv")
+    app.tabs.active = 3
+    app.state.run_fit()
+    r = app.state.fit_result
+    assert "shear_modulus" in r.undetermined
+    text = app.measured.results.object
+    row = next(line for line in text.splitlines() if line.startswith("| µ"))
+    assert row.split("|")[3].strip() == "–" and "not bounded" in row and "**not determined**" in row
+    assert "⚠ shear_modulus is not determined by these data" in text
 
 
 def test_fit_without_data_says_so(app):

@@ -103,6 +103,10 @@ class Diagnosis:
             out["baseline_effects"] = [eid for eid, _ in self.baseline.design.effects]
         if self.held_out:
             out["held_out"] = self.held_out
+        fit = self.final.fit.report()
+        if "intervals" in fit:
+            out["uncertainty"] = {k: fit[k] for k in ("confidence", "intervals", "undetermined")}
+            out["uncertainty"]["warnings"] = fit.get("warnings", [])
         return out
 
     def to_json(self) -> str:
@@ -138,6 +142,8 @@ def summary(diagnosis: Diagnosis) -> str:
     if diagnosis.unexplained:
         lines.append(f"unexplained: a misfit above the noise remains, no effect of the library explains it: "
                      f"{diagnosis.where_remaining}")
+    for warning in diagnosis.final.fit.warnings:
+        lines.append(f"warning: {warning}")
     held = diagnosis.held_out
     if held:
         lines.append(f"held out ({held['left_out']}): gap {held['gap_baseline']:.4g} baseline, "

@@ -42,7 +42,7 @@ class Accepted:
 
 
 def _fit(model: Model, data: MeasuredStiffness, **kwargs) -> Fitted:
-    result = fit_global(model.design, data, free=model.free, **kwargs)
+    result = fit_global(model.design, data, free=model.free, **{"intervals": False, **kwargs})
     k = stiffness_points(result.design, data.frequency_hz, data.amplitude)
     residual = relative_residual(k, data.stiffness)
     return Fitted(Model(result.design, model.branches), result, k, residual, bic(residual, len(model.free)))
@@ -62,7 +62,7 @@ def _candidate_starts(current: Fitted, effect_id: str, data: MeasuredStiffness, 
     """Starting values for a candidate's parameters: the best ``keep`` of a grid across their
     fitting ranges, the rest of the model held at its fitted values."""
     effect = EFFECTS[effect_id]
-    names = [p.name if effect.branch else f"{effect_id}.{p.name}" for p in effect.parameters]
+    names = [effect.fitting_name(p.name) for p in effect.parameters]
     if not names:
         return [{}]
     grid = _grid_values(names, GRID_1D if len(names) == 1 else GRID_2D)
@@ -117,7 +117,8 @@ def _held_out(data: MeasuredStiffness, fits: dict[str, Fitted]) -> dict:
         for level in levels:
             held = values == level
             try:
-                refit = fit_global(fitted.design, data.select(~held), free=fitted.model.free, initial=[{}])
+                refit = fit_global(fitted.design, data.select(~held), free=fitted.model.free, initial=[{}],
+                                   intervals=False)
             except (ValueError, ArithmeticError, ConvergenceError):
                 return {}  # too few points left to refit on: no held-out figure
             predicted[held] = stiffness_points(refit.design, data.frequency_hz[held], data.amplitude[held])
@@ -191,6 +192,12 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
         accepted.append(Accepted(second_id, tried[first_id], joint, {second_id: tried[first_id].bic - joint.bic},
                                  joint, {"found_with": first_id}))
         current = joint
+    # what the data say about the final model's parameters: their profiles (which may also find
+    # a slightly better optimum than the search did)
+    say(0.8, "profiling the final model's parameters")
+    current = _fit(current.model, data, initial=[{}], intervals=True)  # least squares never climbs
+    if not accepted:
+        first = current
     remaining = noise is not None and current.mean_square > NOISE_RATIO * noise
 
     # the words, with the final noise estimate: each misfit described once
@@ -206,9 +213,11 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
     for a in accepted:
         effect = EFFECTS[a.effect]
         values = parameter_values(a.values_from.design)
-        names = {p.name: p.name if effect.branch else f"{a.effect}.{p.name}" for p in effect.parameters}
+        names = {p.name: effect.fitting_name(p.name) for p in effect.parameters}
         params = {p: values[n] for p, n in names.items()}
-        errors = {p: a.values_from.fit.standard_errors.get(n, math.nan) for p, n in names.items()}
+        # a parameter the final profile finds undetermined has no standard error worth quoting
+        errors = {p: math.nan if n in current.fit.undetermined else a.values_from.fit.standard_errors.get(n, math.nan)
+                  for p, n in names.items()}
         steps.append(Step(a.effect, effect.title, where(a.before), a.before.bic - a.after.bic,
                           explains(a.before, a.after, noise)[1], params, a.before.gap, a.after.gap, a.drops,
                           a.evidence, errors))
