@@ -10,6 +10,7 @@ import argparse
 import math
 import re
 import sys
+import time
 import warnings
 from contextlib import contextmanager
 
@@ -259,8 +260,11 @@ def _one_line_errors():
         _fail(f"bushing: internal error ({type(exc).__name__}: {exc})", 1)
 
 
+_open_line = False  # a progress line is on the terminal without its newline
+
+
 def _fail(message: str, status: int):
-    sys.stderr.write(" ".join(message.split()) + "\n")
+    sys.stderr.write(("\n" if _open_line else "") + " ".join(message.split()) + "\n")
     raise SystemExit(status)
 
 
@@ -277,6 +281,30 @@ def _cmd_fit(args) -> None:
         sys.stderr.write(f"bushing fit: warning: {line}\n")
 
 
+class Progress:
+    """Progress of a long run on a terminal: one line rewritten in place, shown only once the
+    run has taken ``after`` seconds (short runs stay silent) and never when ``stream`` is not a
+    terminal (a script reading standard error sees only errors and warnings)."""
+
+    def __init__(self, stream, after: float = 1.0):
+        self.stream, self.after, self.start = stream, after, time.monotonic()
+        try:
+            self.live = stream.isatty()
+        except (AttributeError, ValueError, OSError):
+            self.live = False
+
+    def __call__(self, fraction: float, message: str) -> None:
+        if not self.live or time.monotonic() - self.start < self.after:
+            return
+        global _open_line
+        try:
+            self.stream.write(f"\r\033[Kbushing: {fraction:4.0%} {message}" + ("\n" if fraction >= 1 else ""))
+            self.stream.flush()
+            _open_line = fraction < 1
+        except OSError:
+            self.live = False
+
+
 def _cmd_diagnose(args) -> None:
     from .data import read_stiffness
     from .diagnose import BRANCHES, diagnose, summary
@@ -288,7 +316,7 @@ def _cmd_diagnose(args) -> None:
                          f"got {args.baseline!r}")
     design = read_design(args.design)
     data = read_stiffness(args.measured)
-    result = diagnose(design, data, baseline=baseline)
+    result = diagnose(design, data, baseline=baseline, progress=Progress(sys.stderr))
     report = result.to_json()
     if args.predictions:
         _write_csv(result.predictions(), args.predictions)

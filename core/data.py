@@ -19,6 +19,10 @@ import pandas as pd
 
 MAX_BYTES = 20 * 1024 * 1024
 MAX_ROWS = 200_000
+# fits and the diagnosis work on at most about this many stiffness points (denser data binned)
+# and loop samples (denser loops folded onto one period's phase bins)
+MAX_FIT_POINTS = 2000
+MAX_FIT_SAMPLES = 2000
 
 STIFFNESS_KEYS = ("frequency_hz", "amplitude")
 STIFFNESS_PAIRS = (("magnitude", "loss_factor"), ("stiffness_real", "stiffness_imag"))
@@ -56,18 +60,70 @@ class ComplexStiffness:
 
 @dataclass(frozen=True, eq=False)
 class MeasuredStiffness(ComplexStiffness):
-    """Measured complex dynamic stiffness, one entry per (frequency, amplitude) point."""
+    """Measured complex dynamic stiffness, one entry per (frequency, amplitude) point.
+
+    ``count`` is set on binned data (:meth:`binned`): how many measured points each entry is the
+    mean of. A fit weighs an entry's residual by √count, so that its noise is that of one
+    measured point and the sums of squares are those of all the points."""
 
     frequency_hz: np.ndarray
     amplitude: np.ndarray
     stiffness: np.ndarray  # complex
+    count: np.ndarray | None = None
 
     def __len__(self):
         return self.frequency_hz.size
 
+    @property
+    def weight(self) -> np.ndarray | float:
+        """√count per entry (1 for measured points)."""
+        return 1.0 if self.count is None else np.sqrt(self.count)
+
+    @property
+    def measured_points(self) -> int:
+        return len(self) if self.count is None else int(np.sum(self.count))
+
     def select(self, mask) -> MeasuredStiffness:
         mask = np.asarray(mask)
-        return MeasuredStiffness(self.frequency_hz[mask], self.amplitude[mask], self.stiffness[mask])
+        count = None if self.count is None else self.count[mask]
+        return MeasuredStiffness(self.frequency_hz[mask], self.amplitude[mask], self.stiffness[mask], count)
+
+    def binned(self, max_points: int = MAX_FIT_POINTS) -> MeasuredStiffness:
+        """Dense data reduced to about ``max_points`` entries, each the mean complex stiffness of
+        neighbouring points at their geometric-mean frequency and amplitude (``count`` set);
+        the data themselves if they are not larger. Points are grouped by amplitude (each
+        distinct amplitude, or with many of them bands of equal count in amplitude), and within
+        a group into runs of equal count along the frequency, each group's share of
+        ``max_points`` in proportion to its size: a sweep keeps its shape at every amplitude."""
+        n = len(self)
+        if n <= max_points:
+            return self
+        levels, group = np.unique(self.amplitude, return_inverse=True)
+        exact = levels.size <= max_points // 20
+        if not exact:  # scattered amplitudes: bands of equal count
+            bands = max(1, int(math.sqrt(max_points)))
+            group = (np.argsort(np.argsort(self.amplitude, kind="stable"), kind="stable") * bands) // n
+        label = np.empty(n, dtype=np.int64)
+        offset = 0
+        for g in np.unique(group):
+            members = np.flatnonzero(group == g)
+            bins = max(1, round(max_points * members.size / n))
+            order = members[np.argsort(self.frequency_hz[members], kind="stable")]
+            label[order] = offset + (np.arange(members.size) * bins) // members.size
+            offset += bins
+        _, label = np.unique(label, return_inverse=True)
+        count = np.bincount(label).astype(float)
+
+        def mean(values):
+            return np.bincount(label, weights=values) / count
+
+        stiffness = mean(self.stiffness.real) + 1j * mean(self.stiffness.imag)
+        if exact:  # each bin holds one amplitude: keep it exactly (runs along frequency stay runs)
+            amplitude = np.zeros(count.size)
+            amplitude[label] = self.amplitude
+        else:
+            amplitude = np.exp(mean(np.log(self.amplitude)))
+        return MeasuredStiffness(np.exp(mean(np.log(self.frequency_hz))), amplitude, stiffness, count)
 
     def amplitudes(self) -> np.ndarray:
         """The distinct amplitudes, the most frequent first (ties in increasing order)."""

@@ -33,7 +33,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from .bushing import check_strain, loop_force, stiffness_points
-from .data import MeasuredLoop, MeasuredStiffness
+from .data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from .design import Design, as_dict
 from .effects import EFFECTS, Parameter
 from .uncertainty import CONFIDENCE, profile
@@ -86,14 +86,29 @@ def with_values(design: Design, values: dict[str, float]) -> Design:
     return design.replace(**changes)
 
 
+def folded(phase: np.ndarray, values: np.ndarray, bins: int):
+    """A steady periodic record folded onto one period: the mean phase (in [0, 2π)) and value in
+    each of ``bins`` equal phase bins that holds samples, and their counts; the record itself
+    (counts of 1) if it has no more samples than ``bins``."""
+    if phase.size <= bins:
+        return phase, values, np.ones(phase.size)
+    wrapped = np.mod(phase, 2.0 * np.pi)
+    _, label = np.unique(np.minimum((wrapped * bins / (2.0 * np.pi)).astype(np.int64), bins - 1),
+                         return_inverse=True)
+    count = np.bincount(label).astype(float)
+    return (np.bincount(label, weights=wrapped) / count, np.bincount(label, weights=values) / count, count)
+
+
 def relative_residual(model: np.ndarray, data: np.ndarray) -> np.ndarray:
     """(K_model − K_data) / |K_data|: complex, one per point (the gap's terms, what fits minimise)."""
     return (model - data) / np.abs(data)
 
 
-def gap(model: np.ndarray, data: np.ndarray) -> float:
-    """docs/files.md's gap: sqrt(mean(|K_model − K_data|² / |K_data|²))."""
-    return float(np.sqrt(np.mean(np.abs(relative_residual(model, data)) ** 2)))
+def gap(model: np.ndarray, data: np.ndarray, count: np.ndarray | None = None) -> float:
+    """docs/files.md's gap: sqrt(mean(|K_model − K_data|² / |K_data|²)); over binned data
+    (``count`` points per entry) the mean counts each entry ``count`` times."""
+    square = np.abs(relative_residual(model, data)) ** 2
+    return float(np.sqrt(np.average(square, weights=count)))
 
 
 @dataclass(frozen=True)
@@ -160,16 +175,20 @@ class _Problem:
 
     def __init__(self, design: Design, data: MeasuredStiffness | None, loop: MeasuredLoop | None,
                  free: tuple[str, ...]):
-        self.design, self.data, self.loop, self.free = design, data, loop, free
+        self.design, self.free = design, free
+        self.full_data, self.full_loop = data, loop  # the gap and the loop's misfit are over these
+        self.data = None if data is None else data.binned(MAX_FIT_POINTS)  # the fit works on these
+        self.loop = loop
         self.base = parameter_values(design)
         self.specs = [parameter(p) for p in free]
         if loop is not None:
-            self.loop_f, self.loop_amp, self.loop_phase = loop.harmonic()
-            self.loop_force = loop.force - np.mean(loop.force)
-            self.loop_scale = float(np.sqrt(np.mean(self.loop_force**2)))
-            n_k = 0 if data is None else len(data)
+            self.loop_f, self.loop_amp, phase = loop.harmonic()
+            force = loop.force - np.mean(loop.force)
+            self.loop_scale = float(np.sqrt(np.mean(force**2)))
+            self.loop_phase, self.loop_force, count = folded(phase, force, MAX_FIT_SAMPLES)
+            n_k = 0 if data is None else data.measured_points
             # the loop weighs as much as the stiffness points (or as one point per sample alone)
-            self.loop_weight = math.sqrt(max(n_k, loop.force.size) / loop.force.size)
+            self.loop_weight = math.sqrt(max(n_k, loop.force.size) / loop.force.size) * np.sqrt(count)
 
     def to_theta(self, values: dict) -> np.ndarray:
         return np.array([math.log(values[p]) if s.log else values[p] for p, s in zip(self.free, self.specs)])
@@ -190,7 +209,7 @@ class _Problem:
         parts = []
         if self.data is not None:
             k = stiffness_points(design, self.data.frequency_hz, self.data.amplitude)
-            r = relative_residual(k, self.data.stiffness)
+            r = relative_residual(k, self.data.stiffness) * self.data.weight
             parts += [r.real, r.imag]
         if self.loop is not None:
             f = sum(loop_force(design, self.loop_f, self.loop_amp, self.loop_phase))
@@ -322,14 +341,14 @@ def _result(problem: _Problem, sol, method: str, starts: int, design: Design, in
     fitted = problem.model(sol.x)
     fitted = fitted.replace(name=fitted_name(design.name))
     g = float("nan")
-    if problem.data is not None:
-        g = gap(stiffness_points(fitted, problem.data.frequency_hz, problem.data.amplitude),
-                problem.data.stiffness)
+    data, loop = problem.full_data, problem.full_loop  # every measured point, binned or not
+    if data is not None:
+        g = gap(stiffness_points(fitted, data.frequency_hz, data.amplitude), data.stiffness, data.count)
     loop_rms = None
-    if problem.loop is not None:
-        f = sum(loop_force(fitted, problem.loop_f, problem.loop_amp, problem.loop_phase))
-        loop_rms = float(np.sqrt(np.mean((f - problem.loop_force) ** 2)) / problem.loop_scale)
-    n = 0 if problem.data is None else len(problem.data)
+    if loop is not None:
+        f = sum(loop_force(fitted, problem.loop_f, problem.loop_amp, loop.harmonic()[2]))
+        loop_rms = float(np.sqrt(np.mean((f - (loop.force - np.mean(loop.force))) ** 2)) / problem.loop_scale)
+    n = 0 if data is None else data.measured_points
     return FitResult(fitted, errors, corr, g, float(sol.cost), n, method, starts, loop_rms,
                      intervals=intervals or {}, warnings=tuple(warnings))
 

@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..bushing import stiffness_points
-from ..data import MeasuredStiffness
+from ..data import MAX_FIT_POINTS, MeasuredStiffness
 from ..design import Design
 from ..effects import EFFECTS
 from ..fit import fit_global, gap, parameter, parameter_values, relative_residual
@@ -44,7 +44,7 @@ class Accepted:
 def _fit(model: Model, data: MeasuredStiffness, **kwargs) -> Fitted:
     result = fit_global(model.design, data, free=model.free, **{"intervals": False, **kwargs})
     k = stiffness_points(result.design, data.frequency_hz, data.amplitude)
-    residual = relative_residual(k, data.stiffness)
+    residual = relative_residual(k, data.stiffness) * data.weight  # binned data: one point's noise
     return Fitted(Model(result.design, model.branches), result, k, residual, bic(residual, len(model.free)))
 
 
@@ -73,7 +73,7 @@ def _candidate_starts(current: Fitted, effect_id: str, data: MeasuredStiffness, 
             k = stiffness_points(trial.design, data.frequency_hz, data.amplitude)
         except (ValueError, ArithmeticError, ConvergenceError):
             continue
-        r = relative_residual(k, data.stiffness)
+        r = relative_residual(k, data.stiffness) * data.weight
         if np.all(np.isfinite(r)):
             scored.append((float(np.sum(np.abs(r) ** 2)), values))
     scored.sort(key=lambda s: s[0])
@@ -92,7 +92,8 @@ def _fit_candidate(current: Fitted, effect_id: str, data: MeasuredStiffness) -> 
 
 def _held_out(data: MeasuredStiffness, fits: dict[str, Fitted]) -> dict:
     """Leave one amplitude out (or, with fewer than three amplitudes, one frequency): refit each
-    model on the rest from its fitted values, predict the points left out; the gap over them.
+    model on the rest from its fitted values (dense data binned by the fit), predict every
+    measured point left out; the gap over them.
     With more than :data:`MAX_FOLDS` distinct values (scattered data), bands of equal count are
     left out instead of single values."""
     for axis, values in (("amplitude", data.amplitude), ("frequency", data.frequency_hz)):
@@ -153,6 +154,7 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
     parameters the starting values) with the ``baseline`` branches. Returns a :class:`Diagnosis`.
     """
     say = progress or (lambda fraction, message: None)
+    measured, data = data, data.binned(MAX_FIT_POINTS)  # dense data: the search works on bins
     triples = runs(data)
     say(0.0, "fitting the baseline")
     current = _fit(baseline_model(design, baseline), data, starts=BASELINE_STARTS)
@@ -224,7 +226,24 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
     held = {}
     if held_out:
         say(0.85, "checking on held-out data")
-        held = _held_out(data, {"baseline": first, "final": current})
+        held = _held_out(measured, {"baseline": first, "final": current})
     say(1.0, "done")
-    return Diagnosis(data, first, steps, current, noise, remaining, where(first),
-                     where(current) if remaining else "no misfit above the noise.", held)
+    where_first, where_final = where(first), where(current) if remaining else "no misfit above the noise."
+    if data is not measured:  # the report's gaps and predictions are over every measured point
+        every: dict[int, Fitted] = {}
+
+        def on(fitted: Fitted) -> Fitted:
+            if id(fitted) not in every:
+                every[id(fitted)] = _on(measured, fitted)
+            return every[id(fitted)]
+
+        steps = [replace(s, gap_before=on(a.before).gap, gap_after=on(a.after).gap) for s, a in zip(steps, accepted)]
+        first, current = on(first), on(current)
+    return Diagnosis(measured, first, steps, current, noise, remaining, where_first, where_final, held)
+
+
+def _on(data: MeasuredStiffness, fitted: Fitted) -> Fitted:
+    """``fitted`` (fitted to binned data) evaluated at every point of ``data``."""
+    k = stiffness_points(fitted.design, data.frequency_hz, data.amplitude)
+    fit = replace(fitted.fit, gap=gap(k, data.stiffness), points=len(data))
+    return Fitted(fitted.model, fit, k, relative_residual(k, data.stiffness), fitted.bic)
