@@ -161,17 +161,33 @@ def _effective_slices(design: Design, slices: int | str) -> int | str:
 
 
 MAX_STRAIN = 10.0  # equivalent strain amplitude: 1000 %, far past any rubber's breaking strain
+# the smallest measured equivalent strain amplitude: below any test rig's resolution (for 15 mm of
+# rubber, 15 pm); a measurement claiming less has its units wrong
+MIN_MEASURED_STRAIN = 1e-9
 
 
-def check_strain(design: Design, amplitude) -> None:
+def check_strain(design: Design, amplitude, what: str = "amplitude") -> None:
     """Refuse drive amplitudes whose equivalent strain is beyond :data:`MAX_STRAIN`: no rubber
     survives them, and the formulas' numbers stop being meaningful long before floats fail."""
     x = np.asarray(amplitude, dtype=float)
     if x.size and float(np.max(strain_factor(design.geometry, design.mode) * x)) > MAX_STRAIN:
         unit = UNITS[design.mode]["amplitude"]
         largest = MAX_STRAIN / strain_factor(design.geometry, design.mode)
-        raise ValueError(f"amplitude: at most {largest:.4g} {unit} for this bushing (an equivalent strain of "
+        raise ValueError(f"{what}: at most {largest:.4g} {unit} for this bushing (an equivalent strain of "
                          f"{MAX_STRAIN:g}, {100 * MAX_STRAIN:g} %); got {float(np.max(x)):.4g} {unit}")
+
+
+def check_measured_amplitude(design: Design, amplitude, what: str = "measured amplitude") -> None:
+    """Measured amplitudes must be within what a test can drive and resolve for this bushing:
+    equivalent strains from :data:`MIN_MEASURED_STRAIN` to :data:`MAX_STRAIN`."""
+    check_strain(design, amplitude, what)
+    x = np.asarray(amplitude, dtype=float)
+    c = strain_factor(design.geometry, design.mode)
+    if x.size and float(np.min(c * x)) < MIN_MEASURED_STRAIN:
+        unit = UNITS[design.mode]["amplitude"]
+        raise ValueError(f"{what}: at least {MIN_MEASURED_STRAIN / c:.3g} {unit} for this bushing (an equivalent "
+                         f"strain of {MIN_MEASURED_STRAIN:g}, below any test's resolution); got "
+                         f"{float(np.min(x)):.3g} {unit}: are the units those of docs/files.md (m or rad)?")
 
 
 def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | str = 1,

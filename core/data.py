@@ -23,6 +23,12 @@ MAX_ROWS = 200_000
 # and loop samples (denser loops folded onto one period's phase bins)
 MAX_FIT_POINTS = 2000
 MAX_FIT_SAMPLES = 2000
+# measured frequencies: from creep-like tests to the acoustic range; beyond, the time base or
+# the units are wrong
+MEASURED_FREQUENCY_HZ = (1e-4, 1e5)
+# a loop's drive must be a steady sine: the RMS departure from the best sine, relative to its
+# amplitude, is at most this
+LOOP_SINE_DEPARTURE = 0.1
 
 STIFFNESS_KEYS = ("frequency_hz", "amplitude")
 STIFFNESS_PAIRS = (("magnitude", "loss_factor"), ("stiffness_real", "stiffness_imag"))
@@ -180,6 +186,8 @@ class MeasuredLoop:
     @functools.cached_property
     def _harmonic(self):
         t, x = self.time_s, self.displacement - np.mean(self.displacement)
+        scale = float(np.max(np.abs(x))) or 1.0  # fitted in units of its peak: no overflow
+        x = x / scale
         dt = np.median(np.diff(t))
         spec = np.abs(np.fft.rfft(x * np.hanning(x.size)))
         freqs = np.fft.rfftfreq(x.size, dt)
@@ -187,8 +195,8 @@ class MeasuredLoop:
 
         def fit(f):
             basis = np.column_stack([np.sin(2 * np.pi * f * t), np.cos(2 * np.pi * f * t), np.ones_like(t)])
-            coef, *_ = np.linalg.lstsq(basis, self.displacement, rcond=None)
-            return coef, float(np.sum((basis @ coef - self.displacement) ** 2))
+            coef, *_ = np.linalg.lstsq(basis, x, rcond=None)
+            return coef, float(np.sum((basis @ coef - x) ** 2))
 
         from scipy.optimize import minimize_scalar
 
@@ -197,7 +205,7 @@ class MeasuredLoop:
                                options={"xatol": span * 1e-9})
         f = float(best.x)
         (a, b, _), _ = fit(f)
-        amp = math.hypot(a, b)
+        amp = math.hypot(a, b) * scale
         phase0 = math.atan2(b, a)  # x = amp sin(ωt + phase0)
         return f, amp, 2 * np.pi * f * t + phase0
 
@@ -321,6 +329,11 @@ def parse_stiffness(text: str | bytes) -> MeasuredStiffness:
     v = _numbers(df, (*STIFFNESS_KEYS, *pair), "stiffness")
     _positive(v, "frequency_hz")
     _positive(v, "amplitude")
+    lo, hi = MEASURED_FREQUENCY_HZ
+    outside = np.flatnonzero((v["frequency_hz"] < lo) | (v["frequency_hz"] > hi))
+    if outside.size:
+        raise DataError(f"line {outside[0] + 2}: frequency_hz must be within {lo:g}–{hi:g} Hz, got "
+                        f"{v['frequency_hz'][outside[0]]:g}")
     if pair[0] == "magnitude":
         _positive(v, "magnitude")
         eta = v["loss_factor"]
@@ -354,4 +367,30 @@ def parse_loop(text: str | bytes) -> MeasuredLoop:
         raise DataError(f"line {bad[0] + 3}: time_s must increase (after {v['time_s'][bad[0]]:g})")
     if np.ptp(v["displacement"]) == 0:
         raise DataError("loop file: the displacement never moves")
-    return MeasuredLoop(v["time_s"], v["displacement"], v["force"])
+    loop = MeasuredLoop(v["time_s"], v["displacement"], v["force"])
+    _check_harmonic(loop)
+    return loop
+
+
+def _check_harmonic(loop: MeasuredLoop) -> None:
+    """A loop is a steady harmonic test: a frequency in :data:`MEASURED_FREQUENCY_HZ`, at least
+    one period recorded, a drive close to a sine."""
+    t = loop.time_s
+    span = t[-1] - t[0]
+    dt = float(np.median(np.diff(t)))
+    if not (math.isfinite(span) and span > 0 and math.isfinite(dt) and dt > 0):
+        raise DataError("loop file: time_s does not span a usable interval")
+    with np.errstate(all="ignore"):
+        f, amp, phase = loop.harmonic()
+        x = loop.displacement / amp if amp > 0 else loop.displacement * math.inf
+        departure = float(np.sqrt(np.mean((x - np.mean(x) - np.sin(phase)) ** 2)))
+    lo, hi = MEASURED_FREQUENCY_HZ
+    if not (math.isfinite(f) and lo <= f <= hi):
+        raise DataError(f"loop file: its frequency ({f:.3g} Hz from a time step of {dt:.3g} s) must be within "
+                        f"{lo:g}–{hi:g} Hz; is time_s in seconds?")
+    if f * (span + dt) < 0.99:
+        raise DataError(f"loop file: it holds {f * (span + dt):.2f} of a period at {f:.3g} Hz; at least one "
+                        "whole period is needed")
+    if not departure <= LOOP_SINE_DEPARTURE:
+        raise DataError(f"loop file: the displacement is not a steady sine (its RMS departure from the best "
+                        f"sine is {departure:.0%} of the amplitude; at most {LOOP_SINE_DEPARTURE:.0%})")

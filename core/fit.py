@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
-from .bushing import check_strain, loop_force, stiffness_points
+from .bushing import check_measured_amplitude, loop_force, stiffness_points
 from .data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from .design import Design, as_dict
 from .effects import EFFECTS, Parameter
@@ -370,9 +370,9 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     if data is None and loop is None:
         raise ValueError("give measured stiffness, a measured loop, or both")
     if data is not None:
-        check_strain(design, data.amplitude)  # the measured amplitudes, for this bushing
+        check_measured_amplitude(design, data.amplitude)  # the measured amplitudes, for this bushing
     if loop is not None:
-        check_strain(design, np.max(np.abs(loop.displacement - np.mean(loop.displacement))))
+        check_measured_amplitude(design, loop.harmonic()[1], "the loop's amplitude")
     n = (0 if data is None else 2 * len(data)) + (0 if loop is None else loop.force.size)
     if n <= len(free):
         raise ValueError(f"{n // 2} points cannot determine {len(free)} parameters")

@@ -93,6 +93,8 @@ def test_hostile_measured_files(tmp_path):
     cases = {
         "an amplitude of 1e300": ([*good, (10, 1e300, 4e6, 0.1)], "amplitude"),
         "a negative loss factor": ([*good, (10, 1e-4, 4e6, -0.1)], "negative loss factor"),
+        "a frequency of 1e300 Hz": ([*good, (1e300, 1e-4, 4e6, 0.1)], "frequency_hz must be within"),
+        "an amplitude of 1e-20 m": ([*good, (10, 1e-20, 4e6, 0.1)], "at least"),
     }
     for case, (rows, needle) in cases.items():
         path = stiffness_csv(tmp_path / "m.csv", rows)
@@ -100,6 +102,42 @@ def test_hostile_measured_files(tmp_path):
             r = bushing(command, path, "--design", design)
             assert r.returncode == 2 and r.stdout == "", (case, command, r.stderr)
             assert r.stderr.count("\n") == 1 and needle in r.stderr, (case, command, r.stderr)
+
+
+def _loop_rows(change):
+    t = np.arange(400) / 2000.0  # 2 periods at 10 Hz
+    x = 1e-4 * np.sin(2 * np.pi * 10 * t)
+    f = 400.0 * np.sin(2 * np.pi * 10 * t + 0.2)
+    return change(t, x, f)
+
+
+LOOPS = {
+    "a time step of 1e-300 s": (lambda t, x, f: (t * 1e-300, x, f), "frequency"),
+    "displacements times 1e300": (lambda t, x, f: (t, x * 1e300, f), "at most"),
+    "displacements of 1e-16 m": (lambda t, x, f: (t, x * 1e-12, f), "at least"),
+    "a third of a period": (lambda t, x, f: (t[:67], x[:67], f[:67]), "period"),
+    "a drive that is no sine": (lambda t, x, f: (t, np.sign(np.sin(37 * t)) * np.abs(x) ** 0.5 * 1e-2, f),
+                                "not a steady sine"),
+    "a force of 1e300 N": (lambda t, x, f: (t, x, f * 1e300), None),
+}
+
+
+@pytest.mark.parametrize("case", list(LOOPS))
+def test_hostile_loop_files(case, tmp_path):
+    change, needle = LOOPS[case]
+    t, x, f = _loop_rows(change)
+    path = tmp_path / "loop.csv"
+    path.write_text("time_s,displacement,force\n" + "".join(f"{a:.17g},{b:.17g},{c:.17g}\n" for a, b, c in zip(t, x, f)))
+    r = bushing("fit", EXAMPLES / "paper_b_stiffness.csv", "--design", EXAMPLES / "paper_b_guess.json", "--loop", path)
+    assert "Traceback" not in r.stderr and "internal error" not in r.stderr, (case, r.stderr)
+    if needle is None:  # a valid file: a finite fit, or one clear line
+        if r.returncode == 0:
+            json.loads(r.stdout, parse_constant=lambda c: pytest.fail(f"{c} in the fit file"))
+        else:
+            assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+        return
+    assert r.returncode == 2 and r.stdout == "", (case, r.stderr)
+    assert r.stderr.count("\n") == 1 and needle in r.stderr, (case, r.stderr)
 
 
 def test_a_full_standard_output_is_a_message_not_a_traceback():
@@ -120,6 +158,9 @@ def test_a_fit_to_one_point_repeated_writes_valid_json(tmp_path):
         report = json.loads(r.stdout, parse_constant=lambda c: pytest.fail(f"{c} in the fit file"))
         assert set(report["fit"]["standard_errors"]) == {"shear_modulus", "fractional_coefficient", "fractional_order",
                                                           "friction_stress_max", "friction_strain_half"}
+        # one point is two numbers: at least three of the five parameters stay undetermined
+        assert len(report["fit"]["undetermined"]) >= 3
+        assert all(line.startswith("bushing fit: warning: ") for line in r.stderr.splitlines())
     else:
         assert r.returncode == 2 and r.stderr.count("\n") == 1
 
