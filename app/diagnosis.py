@@ -18,6 +18,7 @@ from . import plots
 from .diagnosis_state import DiagnosisState
 from .live import LivePlot, update_or_keep
 from .units import amplitude_unit
+from .uploads import csv_dropper, on_upload
 
 log = logging.getLogger("bushing.app")
 
@@ -45,10 +46,8 @@ class DiagnosisView(pn.viewable.Viewer):
     def __init__(self, state: DiagnosisState, **params):
         super().__init__(**params)
         self.state = state
-        self.file = pn.widgets.FileInput(accept=".csv,text/csv", sizing_mode="stretch_width",
-                                         description="Measured dynamic stiffness: frequency_hz, amplitude, "
-                                         "magnitude, loss_factor (or stiffness_real, stiffness_imag), SI.")
-        self.file.param.watch(self._on_file, "value")
+        self.file = csv_dropper()
+        on_upload(self.file, state.load_csv)
         self.use_measured = pn.widgets.Button(label="Use the data of “Measured data and fit”", color="light")
         self.use_measured.on_click(lambda _e: state.use_measured())
         self.mystery = pn.widgets.Button(label="Load a mystery data set (demo)", color="light",
@@ -100,10 +99,6 @@ class DiagnosisView(pn.viewable.Viewer):
         self._refresh()
 
     # ---- events --------------------------------------------------------------------------------
-
-    def _on_file(self, event):
-        if event.new is not None:  # an empty file too: it gets its message
-            self.state.load_csv(event.new, self.file.filename or "stiffness file")
 
     async def _run(self, _event):
         state = self.state

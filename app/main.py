@@ -21,7 +21,7 @@ from .state import ExplorerState
 from .teaching import TeachingView
 from .views import PlotView
 
-pn.extension(throttled=False)
+pn.extension("filedropper", throttled=False)  # the upload areas (app.uploads) are in lazy tabs
 
 
 TITLE = "Bushing Explorer"

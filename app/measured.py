@@ -19,6 +19,7 @@ from . import plots
 from .curves import padded
 from .live import LivePlot
 from .state import ExplorerState
+from .uploads import csv_dropper, on_upload
 from .views import PlotView
 
 RESIDUALS = (("magnitude", "frequency"), ("loss", "frequency"), ("magnitude", "amplitude"), ("loss", "amplitude"))
@@ -39,14 +40,10 @@ class MeasuredView(PlotView):
 
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
-        self.stiffness_file = pn.widgets.FileInput(
-            accept=".csv,text/csv", description="Measured dynamic stiffness: frequency_hz, amplitude, "
-            "magnitude, loss_factor (or stiffness_real, stiffness_imag), SI units.", sizing_mode="stretch_width")
-        self.loop_file = pn.widgets.FileInput(
-            accept=".csv,text/csv", description="A measured steady loop: time_s, displacement, force (SI).",
-            sizing_mode="stretch_width")
-        self.stiffness_file.param.watch(self._on_stiffness_file, "value")
-        self.loop_file.param.watch(self._on_loop_file, "value")
+        self.stiffness_file = csv_dropper()
+        self.loop_file = csv_dropper()
+        on_upload(self.stiffness_file, state.load_measured)
+        on_upload(self.loop_file, state.load_measured_loop)
         self.example = pn.widgets.Button(label="Load the synthetic Paper B example", color="light")
         self.example.on_click(self._load_example)
         self.clear = pn.widgets.Button(label="Clear the data", color="light")
@@ -79,16 +76,6 @@ class MeasuredView(PlotView):
     def frame(self, quantity: str, against: str):
         """What a residual plot shows now (``quantity`` "magnitude" or "loss")."""
         return self.residuals.current[RESIDUALS.index((quantity, against))]
-
-    # uploads run in the session: a bad file only sets a message
-
-    def _on_stiffness_file(self, event):
-        if event.new is not None:  # an empty file too: it gets its message
-            self.state.load_measured(event.new, self.stiffness_file.filename or "stiffness file")
-
-    def _on_loop_file(self, event):
-        if event.new is not None:  # an empty file too: it gets its message
-            self.state.load_measured_loop(event.new, self.loop_file.filename or "loop file")
 
     def _load_example(self, _event):
         data, loop = paper_b_example(PAPER_B)
@@ -171,7 +158,7 @@ class MeasuredView(PlotView):
         return pn.Column(
             pn.pane.Markdown(
                 "Load measured dynamic stiffness (and, if you have one, a quasi-static loop) as CSV "
-                "files (drop a file on a button or click it; the formats are in the About tab), or the "
+                "files (drop a file on its area or browse for it, up to 20 MB; the formats are in the About tab), or the "
                 "synthetic example. The points appear over the model in the Explorer tab; the "
                 "residuals are below. **Fit** identifies µ, m, α, σ_fmax and ε½ with standard "
                 "errors and 95 % intervals, and says which parameters the data cannot determine; "

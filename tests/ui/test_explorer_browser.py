@@ -2,10 +2,13 @@
 
 import json
 import re
+from pathlib import Path
 
 import pytest
 
 from core import loads_design
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 pytestmark = pytest.mark.usefixtures("console_errors", "no_server_tracebacks")
 
@@ -248,6 +251,29 @@ def test_upload_fit_and_use(page, explorer_url, tmp_path):
     wait_quiet(page)
     measured = plots(page)["|K| against frequency"]
     assert measured["points"] > 150 * 2  # curves and the 150 measured points
+
+
+def test_an_oversized_file_is_refused_in_the_browser(page, explorer_url, tmp_path, server_log):
+    """A 21 MB file (valid rows) is refused by the drop area with the limit in its message,
+    before anything is sent; the session goes on and takes the next file."""
+    from core.data import MAX_BYTES
+
+    row = "10,0.0001,4200000.0000000000,0.1400000000000000\n"
+    big = tmp_path / "big.csv"
+    big.write_text("frequency_hz,amplitude,magnitude,loss_factor\n" + row * (MAX_BYTES // len(row) + 20_000))
+    assert big.stat().st_size > MAX_BYTES
+    open_explorer(page, explorer_url)
+    page.get_by_text("Measured data and fit", exact=True).click()
+    page.get_by_role("button", name="Fit the five material parameters").wait_for(timeout=20000)
+    inputs = page.locator("input[type=file]")
+    inputs.first.set_input_files(str(big))
+    page.get_by_text("File is too large").first.wait_for(timeout=10000)
+    assert page.get_by_text("Maximum file size is 20 MB").count() >= 1
+    page.wait_for_timeout(1000)
+    assert page.get_by_text("No measured data loaded.").count() == 1  # nothing reached the server
+    inputs.nth(1).set_input_files(str(EXAMPLES / "paper_b_loop.csv"))  # the session goes on
+    page.get_by_text("400 samples at 0.1 Hz").wait_for(timeout=10000)
+    assert not server_log.tracebacks()
 
 
 def test_diagnose_a_hidden_effect_and_use_the_final_model(page, explorer_url, tmp_path):

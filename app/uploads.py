@@ -1,0 +1,43 @@
+"""The explorer's file uploads: Panel's FileDropper (FilePond in the browser).
+
+A file larger than the readers accept (:data:`core.data.MAX_BYTES`) is refused by the browser
+before a byte is sent, with the limit in its message ("File is too large. Maximum file size is
+20 MB"); smaller files travel in chunks well under the websocket's message limit, so no upload
+can close the session.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import panel as pn
+
+from core.data import MAX_BYTES
+
+CHUNK_BYTES = 4 * 1024 * 1024  # per websocket message; the server allows 64 MB
+LIMIT = f"{MAX_BYTES // (1024 * 1024)}MB"
+
+
+def csv_dropper() -> pn.widgets.FileDropper:
+    """A drop area for one CSV file of at most :data:`MAX_BYTES`."""
+    return pn.widgets.FileDropper(
+        accepted_filetypes=[".csv", "text/csv", "text/plain"], max_file_size=LIMIT, chunk_size=CHUNK_BYTES,
+        multiple=False, previews=[], layout="compact", sizing_mode="stretch_width", height=90,
+    )
+
+
+def on_upload(dropper: pn.widgets.FileDropper, load: Callable[[bytes | str, str], object]) -> None:
+    """Call ``load(content, filename)`` with each file dropped (the newest one when the drop
+    area replaces an earlier file; an empty file too: it gets its message). Removing a file
+    from the drop area leaves the data loaded."""
+    seen: dict[str, bytes | str] = {}  # what was loaded (FileDropper changes its dict in place)
+
+    def changed(event):
+        for name, content in event.new.items():
+            if seen.get(name) is not content:
+                seen.clear()
+                seen[name] = content
+                load(content, name)
+                return
+
+    dropper.param.watch(changed, "value")
