@@ -23,7 +23,7 @@ from core.bushing import (
     strain_factor,
 )
 from core.data import MeasuredLoop, MeasuredStiffness, loss_factor, magnitude_residual_pct
-from core.fit import gap
+from core.fit import folded, gap
 from core.material import ConvergenceError
 
 from . import units
@@ -165,10 +165,17 @@ def padded(values, log: bool = False, pad: float = PADDING) -> tuple[float, floa
     return (float(10**start), float(10**end)) if log else (float(start), float(end))
 
 
+# measured data beyond this many points (loop samples) are drawn as bin means (a folded period):
+# a browser draws a few thousand markers at once, not hundreds of thousands in every plot
+DISPLAY_POINTS = 5000
+
+
 def measured_points(measured: MeasuredStiffness | None, mode: str) -> dict | None:
-    """Measured stiffness (SI) in display units, as the sweep plots draw it."""
+    """Measured stiffness (SI) in display units, as the sweep plots draw it (dense data as the
+    means of at most :data:`DISPLAY_POINTS` bins, :meth:`MeasuredStiffness.binned`)."""
     if measured is None:
         return None
+    measured = measured.binned(DISPLAY_POINTS)
     return {"frequency_hz": measured.frequency_hz,
             "amplitude": units.display_amplitude(measured.amplitude, mode),
             "magnitude": units.display_stiffness(measured.magnitude, mode),
@@ -176,10 +183,13 @@ def measured_points(measured: MeasuredStiffness | None, mode: str) -> dict | Non
 
 
 def measured_residuals(design: Design, measured: MeasuredStiffness) -> dict:
-    """``design`` at each measured point against the data: |K| in %, the loss factor, the gap."""
+    """``design`` at each measured point against the data: |K| in %, the loss factor (at the
+    points :func:`measured_points` draws), the gap (over every measured point)."""
     k = stiffness_points(design, measured.frequency_hz, measured.amplitude)
-    return {"magnitude_residual_pct": magnitude_residual_pct(k, measured.stiffness),
-            "loss_factor_residual": loss_factor(k) - measured.loss_factor,
+    shown = measured.binned(DISPLAY_POINTS)
+    k_shown = k if shown is measured else stiffness_points(design, shown.frequency_hz, shown.amplitude)
+    return {"magnitude_residual_pct": magnitude_residual_pct(k_shown, shown.stiffness),
+            "loss_factor_residual": loss_factor(k_shown) - shown.loss_factor,
             "gap": gap(k, measured.stiffness)}
 
 
@@ -188,8 +198,12 @@ def measured_loop_points(measured_loop: MeasuredLoop | None, mode: str) -> dict 
     if measured_loop is None:
         return None
     lp = measured_loop
-    return {"displacement": units.display_amplitude(lp.displacement - np.mean(lp.displacement), mode),
-            "force": lp.force - np.mean(lp.force)}
+    x, force = lp.displacement - np.mean(lp.displacement), lp.force - np.mean(lp.force)
+    if x.size > DISPLAY_POINTS:  # one period, folded: the mean drive and force in each phase bin
+        phase = lp.harmonic()[2]
+        _, x, _ = folded(phase, x, DISPLAY_POINTS)
+        _, force, _ = folded(phase, force, DISPLAY_POINTS)
+    return {"displacement": units.display_amplitude(x, mode), "force": force}
 
 
 @dataclass(frozen=True)

@@ -54,7 +54,13 @@ model (with the thesis' equation numbers), every file and the `bushing` command 
 
 
 URL_DELAY_MS = 300
-UPLOAD_MESSAGE_BYTES = 64 * 1024 * 1024
+# uploads travel in chunks of app.uploads.CHUNK_BYTES (base64 in JSON: 4/3 of it); no other
+# message comes near this
+UPLOAD_MESSAGE_BYTES = 16 * 1024 * 1024
+# a session whose page is closed (or never connected) is discarded, with its memory, after
+# SESSION_LIFETIME_S; the server looks every SESSION_CHECK_S
+SESSION_LIFETIME_S = 15
+SESSION_CHECK_S = 5
 
 
 class ShareLink(param.Parameterized):
@@ -219,10 +225,9 @@ def serve(port: int = 5006, address: str = "localhost", show: bool = False):
         title=TITLE,
         liveness=True,
         verbose=False,
-        # an upload travels base64-encoded in one websocket message: room for the largest file
-        # the readers take (20 MB → 27 MB), so a file just over it gets its message, not a
-        # closed session
         websocket_max_message_size=UPLOAD_MESSAGE_BYTES,
+        unused_session_lifetime_milliseconds=SESSION_LIFETIME_S * 1000,
+        check_unused_sessions_milliseconds=SESSION_CHECK_S * 1000,
     )
     host = "localhost" if address in ("0.0.0.0", "::", "") else address
     print(f"Bushing Explorer: http://{host}:{server.port}/", flush=True)

@@ -104,7 +104,9 @@ class MeasuredView(PlotView):
             d = s.measured
             lines.append(f"**Stiffness**: {len(d)} points, {d.frequency_hz.min():.3g}–{d.frequency_hz.max():.3g} Hz, "
                          f"amplitudes {points['amplitude'].min():.3g}–{points['amplitude'].max():.3g} {s.amplitude_unit}; "
-                         f"gap of the current design: **{residuals['gap']:.4f}**")
+                         f"gap of the current design: **{residuals['gap']:.4f}**"
+                         + (f" (drawn as {len(points['frequency_hz'])} bin means; fits bin them too)"
+                            if len(points["frequency_hz"]) < len(d) else ""))
         if s.measured_loop is not None:
             f, amp, _ = s.measured_loop.harmonic()
             lines.append(f"**Loop**: {s.measured_loop.time_s.size} samples at {f:.3g} Hz, amplitude "

@@ -14,7 +14,7 @@ import panel as pn
 
 from core.data import MAX_BYTES
 
-CHUNK_BYTES = 4 * 1024 * 1024  # per websocket message; the server allows 64 MB
+CHUNK_BYTES = 4 * 1024 * 1024  # per websocket message (app.main.UPLOAD_MESSAGE_BYTES allows 16 MB)
 LIMIT = f"{MAX_BYTES // (1024 * 1024)}MB"
 
 

@@ -109,11 +109,16 @@ class MeasuredStiffness(ComplexStiffness):
         if not exact:  # scattered amplitudes: bands of equal count
             bands = max(1, int(math.sqrt(max_points)))
             group = (np.argsort(np.argsort(self.amplitude, kind="stable"), kind="stable") * bands) // n
+        groups, sizes = np.unique(group, return_counts=True)
+        share = max_points * sizes / n  # each group's bins: largest remainders, at least one
+        shares = np.maximum(np.floor(share).astype(np.int64), 1)
+        spare = max_points - int(shares.sum())
+        if spare > 0:
+            shares[np.argsort(-(share - np.floor(share)), kind="stable")[:spare]] += 1
         label = np.empty(n, dtype=np.int64)
         offset = 0
-        for g in np.unique(group):
+        for g, bins in zip(groups, shares):
             members = np.flatnonzero(group == g)
-            bins = max(1, round(max_points * members.size / n))
             order = members[np.argsort(self.frequency_hz[members], kind="stable")]
             label[order] = offset + (np.arange(members.size) * bins) // members.size
             offset += bins

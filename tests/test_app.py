@@ -12,7 +12,7 @@ from numpy.testing import assert_allclose
 
 from app.main import App, create_app
 from app.state import ExplorerState
-from core import PAPER_B, TABLE_1, loads_design, loop, stiffness
+from core import PAPER_B, TABLE_1, loads_design, loop, stiffness, stiffness_points
 from tests.helpers import element, figures, marker_at, rendered, xy
 
 
@@ -316,6 +316,27 @@ def test_measured_points_appear_over_the_model(app):
     assert app.state.frequency_hz == pytest.approx(0.1) and app.state.amplitude == pytest.approx(1.0)
     lx, _ = data(app.plots.frame("loop"), "measured")
     assert len(lx) == 400 and np.max(np.abs(lx)) == pytest.approx(1.0, rel=1e-6)
+
+
+def test_dense_data_are_drawn_as_bin_means_with_the_gap_over_every_point(app):
+    from app.curves import DISPLAY_POINTS
+    from core.fit import gap
+    from core.synthetic import synthetic_loop, synthetic_stiffness
+
+    dense = synthetic_stiffness(PAPER_B, np.geomspace(1, 100, 4000), [1e-5, 1e-4, 1e-3], seed=2)
+    assert app.state.load_measured(dense.to_csv(), "dense.csv")
+    app.tabs.active = 0
+    x, _ = data(overlay(app, "magnitude", "frequency"), "measured")
+    assert len(x) == DISPLAY_POINTS
+    every = gap(stiffness_points(app.state.design, dense.frequency_hz, dense.amplitude), dense.stiffness)
+    assert app.state.measured_residuals()["gap"] == pytest.approx(every, rel=1e-9)
+    app.tabs.active = 3
+    assert f"drawn as {DISPLAY_POINTS} bin means" in app.measured.summary.object
+    loop = synthetic_loop(PAPER_B, 1.0, 1e-4, periods=4, per_period=5000, seed=3)
+    assert app.state.load_measured_loop(loop.to_csv(), "long_loop.csv")
+    app.tabs.active = 0
+    lx, _ = data(app.plots.frame("loop"), "measured")
+    assert len(lx) == DISPLAY_POINTS and np.max(np.abs(lx)) == pytest.approx(0.1, rel=0.01)  # 1e-4 m in mm
 
 
 def test_bad_files_leave_a_message_and_the_session_going(app):
