@@ -25,7 +25,7 @@ from . import material as mat
 from .data import ComplexStiffness, loss_factor
 from .design import Design, Geometry
 from .effects import EFFECTS, branch_moduli, extended_modulus, inertia_correction, wave_stiffness
-from .slices import continuum_nodes, slice_nodes, solve_series
+from .slices import continuum_node_count, continuum_nodes, slice_nodes, solve_series
 
 UNITS = {
     "axial": {"amplitude": "m", "stiffness": "N/m", "force": "N", "drive": "displacement"},
@@ -147,12 +147,24 @@ def modulus_function(design: Design, route: str = "analytic"):
     raise ValueError(f"route: must be one of {', '.join(ROUTES)}, got {route!r}")
 
 
+# more slices than this add nothing the continuum does not give, at far more cost
+MAX_SLICES = 1000
+
+
 def _check_slices(slices) -> int | str:
     if slices == "continuum":
         return slices
-    if isinstance(slices, bool) or not isinstance(slices, (int, np.integer)) or slices < 1:
-        raise ValueError(f"slices: must be a whole number ≥ 1 or 'continuum', got {slices!r}")
+    if isinstance(slices, bool) or not isinstance(slices, (int, np.integer)) or not 1 <= slices <= MAX_SLICES:
+        raise ValueError(f"slices: must be a whole number from 1 to {MAX_SLICES} or 'continuum' (the limit of "
+                         f"many slices), got {slices!r}")
     return int(slices)
+
+
+def slice_count(design: Design, slices: int | str = 1) -> int:
+    """How many layers a stiffness evaluation with ``slices`` solves in series for ``design``
+    (the continuum's quadrature nodes for ``"continuum"``): the work per point."""
+    slices = _effective_slices(design, _check_slices(slices))
+    return continuum_node_count(design.geometry, design.mode) if slices == "continuum" else int(slices)
 
 
 def _effective_slices(design: Design, slices: int | str) -> int | str:

@@ -16,7 +16,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from .bushing import loop, stiffness
+from .bushing import MAX_SLICES, loop, slice_count, stiffness
 from .data import DataError, csv_text
 from .design import DesignError, read_design
 from .material import ConvergenceError
@@ -26,6 +26,9 @@ NUMBER_FORMAT = "{:.12g}"
 # points, a loop of at most a million samples
 MAX_FREQUENCIES = 100_000
 MAX_GRID = 1_000_000
+# the work of a stiffness run, points × layers (slices, or the continuum's nodes): the closed
+# form does millions a second, the thesis' time-domain simulation about thirty
+MAX_SLICE_POINTS = {"analytic": 20_000_000, "time-domain": 600}
 MAX_LOOP_POINTS = 1_000_000
 NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
 
@@ -105,10 +108,10 @@ def build_parser() -> argparse.ArgumentParser:
     group = st.add_mutually_exclusive_group()
     group.add_argument(
         "--slices",
-        type=_count("--slices"),
+        type=_count("--slices", maximum=MAX_SLICES),
         default=1,
         metavar="N",
-        help="N concentric slices of equal thickness in series (default 1: eqs 17/18)",
+        help=f"N concentric slices of equal thickness in series (default 1: eqs 17/18; at most {MAX_SLICES})",
     )
     group.add_argument(
         "--continuum", action="store_true", help="the continuum limit of infinitely many slices"
@@ -227,13 +230,16 @@ def _cmd_stiffness(args) -> None:
         raise InputError(f"bushing stiffness: {freqs.size} frequencies × {len(args.amp)} amplitudes is more "
                          f"than {MAX_GRID} points; ask for fewer")
     design = read_design(args.design)
-    result = stiffness(
-        design,
-        freqs,
-        args.amp,
-        slices="continuum" if args.continuum else args.slices,
-        route=args.route,
-    )
+    slices = "continuum" if args.continuum else args.slices
+    layers = slice_count(design, slices)
+    work, limit = freqs.size * len(args.amp) * layers, MAX_SLICE_POINTS[args.route]
+    if work > limit:
+        what = f"{layers} layers" if layers > 1 else "1 layer"
+        raise InputError(f"bushing stiffness: {freqs.size * len(args.amp)} points × {what} "
+                         f"({'the continuum' if slices == 'continuum' else 'slices'}) is more than {limit} "
+                         f"point-layers for the {args.route} route; ask for fewer points or slices"
+                         + (" (or the analytic route)" if args.route == "time-domain" else ""))
+    result = stiffness(design, freqs, args.amp, slices=slices, route=args.route)
     _write_csv(_finite(result.table()), args.output)
 
 

@@ -10,6 +10,7 @@ import csv
 import functools
 import io
 import math
+import re
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,6 +30,8 @@ MEASURED_FREQUENCY_HZ = (1e-4, 1e5)
 # a loop's drive must be a steady sine: the RMS departure from the best sine, relative to its
 # amplitude, is at most this
 LOOP_SINE_DEPARTURE = 0.1
+# a number in a data file: plain ASCII decimal notation
+DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
 
 STIFFNESS_KEYS = ("frequency_hz", "amplitude")
 STIFFNESS_PAIRS = (("magnitude", "loss_factor"), ("stiffness_real", "stiffness_imag"))
@@ -287,12 +290,14 @@ def _numbers(df: pd.DataFrame, columns, what: str) -> dict[str, np.ndarray]:
             text = str(cell).strip()
             if text == "":
                 raise DataError(f"line {line}: {col} is missing")
-            try:
-                v = float(text)
-            except ValueError:
-                raise DataError(f"line {line}: {col} is not a number ({text!r})") from None
-            if not math.isfinite(v):
+            if text.lower().lstrip("+-") in ("nan", "inf", "infinity"):
                 raise DataError(f"line {line}: {col} is not finite ({text!r})")
+            if not DECIMAL.fullmatch(text):  # no 1_000, no non-ASCII digits, no hex: what float() forgives
+                raise DataError(f"line {line}: {col} is not a number ({text!r}); numbers are written like "
+                                "4.2e6 or 0.0001")
+            v = float(text)
+            if not math.isfinite(v):
+                raise DataError(f"line {line}: {col} is too large for a number ({text!r})")
             values[i] = v
         out[col] = values
     return out
