@@ -293,8 +293,8 @@ def _numbers(df: pd.DataFrame, columns, what: str) -> dict[str, np.ndarray]:
             if text.lower().lstrip("+-") in ("nan", "inf", "infinity"):
                 raise DataError(f"line {line}: {col} is not finite ({text!r})")
             if not DECIMAL.fullmatch(text):  # no 1_000, no non-ASCII digits, no hex: what float() forgives
-                raise DataError(f"line {line}: {col} is not a number ({text!r}); numbers are written like "
-                                "4.2e6 or 0.0001")
+                hint = "; numbers are written like 4.2e6 or 0.0001" if any(c.isdigit() for c in text) else ""
+                raise DataError(f"line {line}: {col} is not a number ({text!r}){hint}")
             v = float(text)
             if not math.isfinite(v):
                 raise DataError(f"line {line}: {col} is too large for a number ({text!r})")

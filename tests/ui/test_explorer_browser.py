@@ -262,6 +262,7 @@ def test_an_oversized_file_is_refused_in_the_browser(page, explorer_url, tmp_pat
     big = tmp_path / "big.csv"
     big.write_text("frequency_hz,amplitude,magnitude,loss_factor\n" + row * (MAX_BYTES // len(row) + 20_000))
     assert big.stat().st_size > MAX_BYTES
+    logged = len(server_log.records)
     open_explorer(page, explorer_url)
     page.get_by_text("Measured data and fit", exact=True).click()
     page.get_by_role("button", name="Fit the five material parameters").wait_for(timeout=20000)
@@ -273,7 +274,10 @@ def test_an_oversized_file_is_refused_in_the_browser(page, explorer_url, tmp_pat
     assert page.get_by_text("No measured data loaded.").count() == 1  # nothing reached the server
     inputs.nth(1).set_input_files(str(EXAMPLES / "paper_b_loop.csv"))  # the session goes on
     page.get_by_text("400 samples at 0.1 Hz").wait_for(timeout=10000)
-    assert not server_log.tracebacks()
+    # what the server logged meanwhile (an earlier test's page closing mid-write makes tornado
+    # log a WebSocketClosedError: a closed page, not this upload)
+    new = [r for r in server_log.records[logged:] if r.exc_info or "Traceback" in r.getMessage()]
+    assert not [r for r in new if "WebSocketClosedError" not in r.getMessage()], new
 
 
 def test_diagnose_a_hidden_effect_and_use_the_final_model(page, explorer_url, tmp_path):
