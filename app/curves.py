@@ -37,7 +37,7 @@ def fletcher_gent_amplitudes(design: Design, n: int = 5, ratios=None) -> np.ndar
     """Drive amplitudes (display units) at equivalent strains ``ratios`` × ε½, by default ``n``
     log-spaced over the Fletcher–Gent range ε̂/ε½ = 1e-3 … 1e2."""
     z = np.geomspace(*units.FG_RANGE, n) if ratios is None else np.asarray(ratios, dtype=float)
-    c = strain_factor(design.geometry, design.mode)
+    c = strain_factor(design.geometry, design.mode, design.shape)
     return units.display_amplitude(z * design.material.friction_strain_half / c, design.mode)
 
 
@@ -45,7 +45,7 @@ def amplitude_bounds(design: Design) -> tuple[float, float]:
     """The amplitude axis (display units): the Fletcher–Gent range, up to the largest strain the
     core computes (:data:`core.bushing.MAX_STRAIN`)."""
     x = fletcher_gent_amplitudes(design, 2)
-    top = units.display_amplitude(MAX_STRAIN / strain_factor(design.geometry, design.mode), design.mode)
+    top = units.display_amplitude(MAX_STRAIN / strain_factor(design.geometry, design.mode, design.shape), design.mode)
     return float(min(x[0], top / 10)), float(min(x[1], top))
 
 
@@ -109,6 +109,10 @@ def slice_comparison(design: Design, frequency_hz: float, amplitudes) -> dict:
         try:
             r = stiffness(model, frequency_hz, units.to_si_amplitude(x, design.mode), slices=s)
         except ConvergenceError:
+            continue
+        except ValueError:  # slices are derived for the long axial and torsion bushing only
+            if s == 1:
+                raise
             continue
         out["magnitude"][s] = units.display_stiffness(r.magnitude[:, 0], design.mode)
         out["loss_factor"][s] = r.loss_factor[:, 0]
@@ -300,3 +304,20 @@ def curve_groups(r, most: int = 5) -> list[dict]:
             "final": (units.display_stiffness(np.abs(kf), mode), loss_factor(kf)),
         })
     return groups
+
+
+def card_sweeps(design: Design, frequency_hz: float, strains=None) -> dict:
+    """The bushing card's curves (:mod:`core.card`): for each direction, the drive amplitude in
+    display units, |K| in display units and the loss factor at ``frequency_hz``, over a grid of
+    equivalent strains (the same grid for every direction, so the loss factors share an axis)."""
+    from core.card import CARD_MODES, card_design
+
+    eps = np.geomspace(1e-5, 1e-1, 60) if strains is None else np.asarray(strains, dtype=float)
+    out = {"strain": eps}
+    for mode in CARD_MODES:
+        d = card_design(material_model(design), mode)
+        c = strain_factor(d.geometry, mode, d.shape)
+        k = stiffness_points(d, frequency_hz, eps / c)
+        out[mode] = {"amplitude": units.display_amplitude(eps / c, mode),
+                     "magnitude": units.display_stiffness(np.abs(k), mode), "loss_factor": loss_factor(k)}
+    return out

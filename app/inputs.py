@@ -9,7 +9,7 @@ import typing
 import panel as pn
 from bokeh.models import CustomJSTickFormatter
 
-from core.bushing import STRUCTURAL_EFFECTS
+from core.bushing import STRUCTURAL_EFFECTS, shape_factor
 
 from .state import DESIGN_FIELDS, ExplorerState
 from .units import OPERATING_FREQUENCIES
@@ -133,11 +133,22 @@ class DesignInputs(pn.viewable.Viewer):
             state.param.mode, description=state.param.mode.doc, color="primary",
             variant="outline", sizing_mode="stretch_width",
         )
+        self.finite_length = pn.widgets.Switch.from_param(state.param.finite_length, margin=(8, 4, 0, 10))
+        self.shape_note = pn.pane.Markdown("", sizing_mode="stretch_width", margin=(0, 10),
+                                           styles={"font-size": "0.9em"})
+        state.param.watch(lambda *_e: self._shape_note(), ["design", "finite_length", "mode"])
+        self._shape_note()
         self.amplitude = LogSlider(state, "amplitude", lambda: state.amplitude_bounds, lambda: state.amplitude_unit)
         self.frequency = LogSlider(state, "frequency_hz", lambda: OPERATING_FREQUENCIES, lambda: "Hz")
 
     def _field(self, name):
         return pn.Column(self.widgets[name], error_text(self.state, name), margin=0, sizing_mode="stretch_width")
+
+    def _shape_note(self):
+        """How far the finite-length shape factor is from the long-bushing formula, for this
+        design (axial and radial; torsion's agree; conical has no formula)."""
+        self.finite_length.disabled = self.state.mode in ("radial", "conical")
+        self.shape_note.object = shape_comparison(self.state.design)
 
     def __panel__(self):
         geometry = [self._field(n) for n in ("inner_radius_mm", "outer_radius_mm", "length_mm")]
@@ -145,6 +156,9 @@ class DesignInputs(pn.viewable.Viewer):
         return pn.Column(
             self.preset,
             self.mode,
+            pn.Row(self.finite_length, pn.pane.Markdown("Finite-length shape factor", margin=(6, 4)),
+                   sizing_mode="stretch_width"),
+            self.shape_note,
             pn.pane.Markdown("**Operating point**", margin=(8, 10, 0, 10)),
             self.amplitude,
             self.frequency,
@@ -154,6 +168,23 @@ class DesignInputs(pn.viewable.Viewer):
                     sizing_mode="stretch_width"),
             sizing_mode="stretch_width",
         )
+
+
+def shape_comparison(design) -> str:
+    """One line: the finite-length S against the long formula for this design's mode."""
+    g, mode = design.geometry, design.mode
+    try:
+        finite = shape_factor(g, mode, "finite")
+        if mode == "conical":
+            return f"Conical S = {finite:.4g} m³ (finite-element; no closed form holds for real lengths)."
+        long = shape_factor(g, mode, "long")
+    except ValueError as exc:
+        return f"Finite-length S not available: {exc}"
+    if mode == "torsion":
+        return "Torsion: the closed form is exact at any length (the finite-element S agrees)."
+    used = "finite-element" if design.shape_kind == "finite" else "long-bushing formula"
+    return (f"Finite-length S is {finite / long:.3f} of the long-bushing formula "
+            f"({100 * (finite / long - 1):+.1f} %); in use: the {used}.")
 
 
 def status_banner(state: ExplorerState):

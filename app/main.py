@@ -10,6 +10,7 @@ import panel as pn
 import param
 
 from . import patches
+from .card import CardView
 from .diagnosis import DiagnosisView
 from .diagnosis_state import DiagnosisState
 from .explorer import CompareView, ExplorerPlots
@@ -29,8 +30,8 @@ TITLE = "Bushing Explorer"
 ABOUT = """
 ### Bushing Explorer
 
-Dynamic stiffness of carbon-black-filled rubber bushings, axially and in torsion, over frequency
-and amplitude, with the Fletcher–Gent (Payne) effect: the engineering formulas of M.-J. García
+Dynamic stiffness of carbon-black-filled rubber bushings, axially, radially, in torsion and
+tilted (conical), over frequency and amplitude, with the Fletcher–Gent (Payne) effect: the engineering formulas of M.-J. García
 Tárrago (KTH, 2006). Set the geometry and the five material parameters on the left, pick the
 operating point (drive amplitude and loop frequency), and read the loop, the stiffness magnitude
 |K| and the loss factor. **Tap** any frequency or amplitude plot to move the operating point
@@ -38,14 +39,20 @@ there; every plot follows. All numbers come from the closed-form steady state, w
 check against the thesis' time-domain simulation.
 
 **Units.** Radii and length in mm; µ and m in MPa (m in MPa·s^α); σ_fmax in kPa; ε½ and α
-plain numbers; the drive in mm (axial) or rad (torsion), as peak values. |K| in kN/mm (= MN/m)
-axially and N·m/rad in torsion. Files and the command line use SI.
+plain numbers; the drive in mm (axial, radial) or rad (torsion, conical), as peak values. |K| in
+kN/mm (= MN/m) or N·m/rad. Files and the command line use SI.
+
+**Shape factors.** Axial and torsion use the thesis' closed forms unless *Finite-length shape
+factor* is on; radial and conical always use the finite-element table (the rubber between rigid
+bonded sleeves, ends free, b/a 1.2–4 and L/(b − a) 0.5–12). Each direction's equivalent strain
+follows from the energy balance, ε_eq = x̂ √(S / (4V)).
 
 **Files.** *Measured stiffness* (CSV): a header row `frequency_hz,amplitude,magnitude,loss_factor`
 (or `stiffness_real,stiffness_imag` instead of the last two), then one row per point; amplitude
-the peak displacement in m (axial) or angle in rad (torsion), |K| in N/m or N·m/rad. *Measured
+the peak displacement in m (axial, radial) or angle in rad (torsion, conical), |K| in N/m or N·m/rad. *Measured
 loop* (CSV): `time_s,displacement,force`, one or more periods of a steady harmonic test. *Design
-file* (JSON): `mode`, `geometry` (`inner_radius`, `outer_radius`, `length` in m), `material`
+file* (JSON): `mode` (`axial`, `torsion`, `radial`, `conical`), optional `shape` (`long`,
+`finite`), `geometry` (`inner_radius`, `outer_radius`, `length` in m), `material`
 (`shear_modulus`, `fractional_coefficient` and `friction_stress_max` in Pa, `fractional_order`,
 `friction_strain_half`), optionally `name` and `effects`. A row or key that is missing, not a
 number or out of range is refused with its line or key. The repository's `docs/` describe the
@@ -69,11 +76,12 @@ class ShareLink(param.Parameterized):
     at once; the state's changes reach the address bar after a pause, so a slider drag is one
     history entry and one URL write, not one per step."""
 
-    mode = param.Selector(objects=["axial", "torsion"], default="axial")
+    mode = param.Selector(objects=["axial", "torsion", "radial", "conical"], default="axial")
+    finite_length = param.Boolean(default=False)
 
 
 for _name in URL_NAMES:
-    if _name != "mode":
+    if _name not in ("mode", "finite_length"):
         ShareLink.param.add_parameter(_name, param.Number(default=None, allow_None=True))
 
 
@@ -96,6 +104,7 @@ class App(pn.viewable.Viewer):
         ("Fletcher–Gent, branch by branch", "teaching", lambda app: TeachingView(app.state)),
         ("Measured data and fit", "measured", lambda app: MeasuredView(app.state)),
         ("Find the missing effect", "diagnosis", lambda app: DiagnosisView(DiagnosisState(app.state))),
+        ("Every direction", "card", lambda app: CardView(app.state)),
     )
 
     def __init__(self, state: ExplorerState | None = None, **params):
@@ -119,6 +128,7 @@ class App(pn.viewable.Viewer):
 
     slices = property(lambda self: self.view("slices"))
     teaching = property(lambda self: self.view("teaching"))
+    card = property(lambda self: self.view("card"))
     measured = property(lambda self: self.view("measured"))
     diagnosis = property(lambda self: self.view("diagnosis"))
 

@@ -47,6 +47,7 @@ class ExportView(pn.viewable.Viewer):
 
 URL_NAMES = {
     "mode": "mode",
+    "finite_length": "finite",
     "inner_radius_mm": "a_mm",
     "outer_radius_mm": "b_mm",
     "length_mm": "L_mm",

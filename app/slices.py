@@ -56,7 +56,12 @@ class SlicesView(PlotView):
                 rows.append(f"| {self.NAMES[s]} | {dm[im]:+.2f} % at {xs[im]:.3g} {unit} "
                             f"| {de[ie]:+.2f} % at {xs[ie]:.3g} {unit} |")
         missing = [self.NAMES[s] for s in (2, 3, "continuum") if s not in data["magnitude"]]
-        if missing:
+        design = self.state.design
+        if design.mode not in ("axial", "torsion") or design.shape_kind != "long":
+            rows.append(f"\n_Slices and the continuum are derived for axial and torsion bushings with the "
+                        f"long (closed-form) shape factors; this design is {design.mode} with the "
+                        f"{design.shape_kind} shape: only the single modulus is shown._")
+        elif missing:
             rows.append(f"\n_Not shown, the iteration did not converge: {', '.join(missing)}._")
         return "\n".join(rows)
 

@@ -14,7 +14,7 @@ import numpy as np
 import param
 
 from core import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material
-from core.bushing import stiffness, strain_factor
+from core.bushing import factors, stiffness, strain_factor
 from core.data import (
     DataError,
     MeasuredLoop,
@@ -54,7 +54,7 @@ PRESETS = {"Paper B bushing (axial)": PAPER_B, "Table 1 bushing (torsion)": TABL
 
 def _display_values(design: Design) -> dict:
     """The state parameters that show ``design``."""
-    values = {"mode": design.mode}
+    values = {"mode": design.mode, "finite_length": design.shape == "finite"}
     for name, (key, factor) in GEOMETRY_FIELDS.items():
         values[name] = getattr(design.geometry, key) / factor
     for name, (key, factor) in MATERIAL_FIELDS.items():
@@ -83,8 +83,15 @@ class ExplorerState(param.Parameterized):
         doc="Load a bushing from the thesis: Paper B (axial) or Table 1 (torsion).",
     )
     mode = param.Selector(
-        objects=["axial", "torsion"], default="axial", label="Mode",
-        doc="Axial: outer sleeve moved along the axis. Torsion: outer sleeve turned about it.",
+        objects=["axial", "torsion", "radial", "conical"], default="axial", label="Mode",
+        doc="Axial: the sleeves moved apart along the axis. Torsion: turned about it. Radial: moved "
+        "apart across it. Conical: tilted about a diameter.",
+    )
+    finite_length = param.Boolean(
+        False, label="Finite-length shape factor",
+        doc="Axial and torsion: the thesis' closed forms (long bushing) or the finite-element "
+        "shape factor of this length (torsion's are the same). Radial and conical always use "
+        "the finite-element one.",
     )
     inner_radius_mm = _number("Radius of the inner (bonded) sleeve.", "Inner radius a (mm)", 20.0)
     outer_radius_mm = _number("Radius of the outer (bonded) sleeve; larger than a.", "Outer radius b (mm)", 35.0)
@@ -147,12 +154,16 @@ class ExplorerState(param.Parameterized):
         if names != {"mode"}:
             return
         old, new = events[0].old, events[0].new
-        geometry = self.design.geometry
-        eps = strain_factor(geometry, old) * units.to_si_amplitude(self.amplitude, old)
-        x = units.display_amplitude(eps / strain_factor(geometry, new), new)
+        geometry, shape = self.design.geometry, "finite" if self.finite_length else None
+        try:
+            eps = strain_factor(geometry, old, shape) * units.to_si_amplitude(self.amplitude, old)
+            x = units.display_amplitude(eps / strain_factor(geometry, new, shape), new)
+        except ValueError:  # a geometry outside the finite-length table: the validation says so
+            return
         self.amplitude = float(f"{x:.3g}")
 
-    @param.depends(*DESIGN_FIELDS, "mode", "effects", "freq_min", "freq_max", watch=True, on_init=False)
+    @param.depends(*DESIGN_FIELDS, "mode", "finite_length", "effects", "freq_min", "freq_max", watch=True,
+                   on_init=False)
     def _validate(self):
         errors = {}
         values = {}
@@ -178,9 +189,13 @@ class ExplorerState(param.Parameterized):
             try:
                 geometry = Geometry(**{k: values[k] for k, _ in GEOMETRY_FIELDS.values()})
                 material = Material(**{k: values[k] for k, _ in MATERIAL_FIELDS.values()})
-                design = Design(self.mode, geometry, material, effects=self.effects)
+                shape = "finite" if self.finite_length else None
+                design = Design(self.mode, geometry, material, effects=self.effects, shape=shape)
+                factors(design)  # the shape factor exists for this geometry (the FE table's range)
             except DesignError as exc:
                 errors[ERROR_FIELD.get(exc.key, "mode")] = _plain(exc)
+            except ValueError as exc:  # outside the finite-length table: a geometry to change
+                errors["length_mm"] = f"{exc}."
             else:
                 design = _match_shown(design, [*PRESETS.values(), *self._loaded])
                 if design != self.design:

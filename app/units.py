@@ -1,8 +1,8 @@
 """Display units of the explorer and of the plotting API, in one place.
 
 Files, the command line and the core use SI. What people read is in the units below: lengths in
-mm, moduli in MPa (σ_fmax in kPa), the drive amplitude in mm axially and rad in torsion, the
-stiffness in kN/mm (= MN/m) axially and N·m/rad in torsion. Each table maps a mode to
+mm, moduli in MPa (σ_fmax in kPa), the drive amplitude in mm axially and radially and rad in
+torsion and tilt (conical), the stiffness in kN/mm (= MN/m) and N·m/rad. Each table maps a mode to
 ``(unit, factor)``: display value × factor = SI value.
 """
 
@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 
-AMPLITUDE = {"axial": ("mm", 1e-3), "torsion": ("rad", 1.0)}
-STIFFNESS = {"axial": ("kN/mm", 1e6), "torsion": ("N·m/rad", 1.0)}
-FORCE = {"axial": ("N", 1.0), "torsion": ("N·m", 1.0)}
-DRIVE = {"axial": "Displacement", "torsion": "Angle"}
-LOAD = {"axial": "Force", "torsion": "Moment"}
+AMPLITUDE = {"axial": ("mm", 1e-3), "torsion": ("rad", 1.0), "radial": ("mm", 1e-3), "conical": ("rad", 1.0)}
+STIFFNESS = {"axial": ("kN/mm", 1e6), "torsion": ("N·m/rad", 1.0), "radial": ("kN/mm", 1e6),
+             "conical": ("N·m/rad", 1.0)}
+FORCE = {"axial": ("N", 1.0), "torsion": ("N·m", 1.0), "radial": ("N", 1.0), "conical": ("N·m", 1.0)}
+DRIVE = {"axial": "Displacement", "torsion": "Angle", "radial": "Displacement", "conical": "Tilt angle"}
+LOAD = {"axial": "Force", "torsion": "Moment", "radial": "Force", "conical": "Moment"}
 
 # the frequencies the explorer accepts (Hz), for the operating point and the sweeps
 FREQUENCY_BOUNDS = (0.01, 10_000.0)

@@ -22,36 +22,51 @@ from typing import Literal
 import numpy as np
 
 from . import material as mat
+from . import shape as shapes
 from .data import ComplexStiffness, loss_factor
-from .design import Design, Geometry
+from .design import DEFAULT_SHAPE, Design, Geometry
 from .effects import EFFECTS, branch_moduli, extended_modulus, inertia_correction, wave_stiffness
 from .slices import continuum_node_count, continuum_nodes, slice_nodes, solve_series
 
 UNITS = {
     "axial": {"amplitude": "m", "stiffness": "N/m", "force": "N", "drive": "displacement"},
     "torsion": {"amplitude": "rad", "stiffness": "N·m/rad", "force": "N·m", "drive": "angle"},
+    "radial": {"amplitude": "m", "stiffness": "N/m", "force": "N", "drive": "displacement"},
+    "conical": {"amplitude": "rad", "stiffness": "N·m/rad", "force": "N·m", "drive": "angle"},
 }
 
 Route = Literal["analytic", "time-domain"]
 ROUTES = ("analytic", "time-domain")
 
 
-def strain_factor(geometry: Geometry, mode: str) -> float:
-    """c with ε_eq = c·x: torsion c = a b / (b² − a²) (eq 14); axial
-    c = 1 / sqrt(2 (b² − a²) ln(b/a)) (eq 15). Units 1/rad or 1/m."""
-    a, b = geometry.inner_radius, geometry.outer_radius
-    if mode == "torsion":
-        return a * b / (b * b - a * a)
-    return 1.0 / np.sqrt(2.0 * (b * b - a * a) * np.log(b / a))
-
-
-def shape_factor(geometry: Geometry, mode: str) -> float:
-    """S with K = S·µ_eq: torsion S = 4π a² b² L / (b² − a²) (eq 17, m³/rad);
-    axial S = 2π L / ln(b/a) (eq 18, m)."""
+def shape_factor(geometry: Geometry, mode: str, shape: str | None = None) -> float:
+    """S with K = S·µ_eq (m for axial and radial, m³/rad for torsion and conical): the closed
+    forms of :mod:`core.shape` for ``shape="long"`` (torsion S = 4π a² b² L / (b² − a²),
+    eq 17; axial S = 2π L / ln(b/a), eq 18; radial, plane strain), the finite-length FE table
+    for ``"finite"``; ``None``: the mode's default (long for axial and torsion, finite for
+    radial and conical)."""
     a, b, L = geometry.inner_radius, geometry.outer_radius, geometry.length
-    if mode == "torsion":
-        return 4.0 * np.pi * a * a * b * b * L / (b * b - a * a)
-    return 2.0 * np.pi * L / np.log(b / a)
+    if (shape or DEFAULT_SHAPE[mode]) == "finite":
+        return shapes.finite_shape_factor(a, b, L, mode)
+    return shapes.long_shape_factor(a, b, L, mode)
+
+
+def strain_factor(geometry: Geometry, mode: str, shape: str | None = None) -> float:
+    """c with ε_eq = c·x from the energy balance, c = √(S / (4V)), V = π(b² − a²)L: with the
+    long shape factors, torsion c = a b / (b² − a²) (eq 14) and axial
+    c = 1 / sqrt(2 (b² − a²) ln(b/a)) (eq 15). Units 1/rad or 1/m."""
+    a, b, L = geometry.inner_radius, geometry.outer_radius, geometry.length
+    if mode == "torsion" and (shape or DEFAULT_SHAPE[mode]) == "long":
+        return a * b / (b * b - a * a)  # eq 14, the same number without round-off
+    if mode == "axial" and (shape or DEFAULT_SHAPE[mode]) == "long":
+        return 1.0 / np.sqrt(2.0 * (b * b - a * a) * np.log(b / a))  # eq 15
+    return shapes.strain_factor_from_shape(shape_factor(geometry, mode, shape), a, b, L)
+
+
+def factors(design: Design) -> tuple[float, float]:
+    """(S, c) of a design: its shape factor and strain factor."""
+    return (shape_factor(design.geometry, design.mode, design.shape),
+            strain_factor(design.geometry, design.mode, design.shape))
 
 
 # --------------------------------------------------------------------------------------------
@@ -167,6 +182,16 @@ def slice_count(design: Design, slices: int | str = 1) -> int:
     return continuum_node_count(design.geometry, design.mode) if slices == "continuum" else int(slices)
 
 
+def _check_series(design: Design, slices: int | str) -> None:
+    """Slices, the continuum and standing waves are derived for the thesis' axial and torsion
+    bushings (long shape factors): refuse them elsewhere rather than guess."""
+    series = slices != 1 or "wave_effects" in design.effect_parameters
+    if series and (design.mode not in ("axial", "torsion") or design.shape_kind != "long"):
+        what = "slices, the continuum, nonuniform_strain and wave_effects"
+        raise ValueError(f"{what} are derived for axial and torsion bushings with the long (closed-form) shape "
+                         f"factors; this design is {design.mode} with the {design.shape_kind} shape")
+
+
 def _effective_slices(design: Design, slices: int | str) -> int | str:
     """The continuum where one slice is asked of a design with the nonuniform_strain effect."""
     return "continuum" if slices == 1 and "nonuniform_strain" in design.effect_parameters else slices
@@ -182,9 +207,10 @@ def check_strain(design: Design, amplitude, what: str = "amplitude") -> None:
     """Refuse drive amplitudes whose equivalent strain is beyond :data:`MAX_STRAIN`: no rubber
     survives them, and the formulas' numbers stop being meaningful long before floats fail."""
     x = np.asarray(amplitude, dtype=float)
-    if x.size and float(np.max(strain_factor(design.geometry, design.mode) * x)) > MAX_STRAIN:
+    c = strain_factor(design.geometry, design.mode, design.shape)
+    if x.size and float(np.max(c * x)) > MAX_STRAIN:
         unit = UNITS[design.mode]["amplitude"]
-        largest = MAX_STRAIN / strain_factor(design.geometry, design.mode)
+        largest = MAX_STRAIN / c
         raise ValueError(f"{what}: at most {largest:.4g} {unit} for this bushing (an equivalent strain of "
                          f"{MAX_STRAIN:g}, {100 * MAX_STRAIN:g} %); got {float(np.max(x)):.4g} {unit}")
 
@@ -194,7 +220,7 @@ def check_measured_amplitude(design: Design, amplitude, what: str = "measured am
     equivalent strains from :data:`MIN_MEASURED_STRAIN` to :data:`MAX_STRAIN`."""
     check_strain(design, amplitude, what)
     x = np.asarray(amplitude, dtype=float)
-    c = strain_factor(design.geometry, design.mode)
+    c = strain_factor(design.geometry, design.mode, design.shape)
     if x.size and float(np.min(c * x)) < MIN_MEASURED_STRAIN:
         unit = UNITS[design.mode]["amplitude"]
         raise ValueError(f"{what}: at least {MIN_MEASURED_STRAIN / c:.3g} {unit} for this bushing (an equivalent "
@@ -218,8 +244,9 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
     check_strain(design, x)
     effects = design.effect_parameters
     modulus = modulus_function(design, route)
-    c = strain_factor(geo, mode)
+    s, c = factors(design)
     slices = _effective_slices(design, slices)
+    _check_series(design, slices)
     if "wave_effects" in effects:
         if slices != 1:
             raise ValueError(
@@ -229,7 +256,7 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
         k = wave_stiffness(mode, geo.inner_radius, geo.outer_radius, geo.length,
                            modulus(f, c * x), f, effects["wave_effects"]["density"])
     elif slices == 1:
-        k = shape_factor(geo, mode) * modulus(f, c * x)  # eqs 16–18
+        k = s * modulus(f, c * x)  # eqs 16–18
     else:
         nodes = continuum_nodes(geo, mode) if slices == "continuum" else slice_nodes(geo, mode, slices)
         fp, xp = (np.broadcast_to(v, shape).ravel() for v in (f, x))
@@ -294,8 +321,8 @@ def branch_stiffness(design: Design, frequency_hz, amplitude) -> dict[str, np.nd
     _refuse_structural_effects(design, "the branch-by-branch stiffness")
     f = _grid("frequency_hz", frequency_hz)[None, :]
     x = _grid("amplitude", amplitude)[:, None]
-    s = shape_factor(design.geometry, design.mode)
-    eps = strain_factor(design.geometry, design.mode) * x
+    s, c = factors(design)
+    eps = c * x
     return {name: s * modulus for name, modulus in
             branch_moduli(design.material, design.effect_parameters, f, eps).items()}
 
@@ -385,8 +412,8 @@ def loop(
     if route == "analytic":
         forces = loop_force(design, f, xa, theta)
     elif route == "time-domain":
-        c = strain_factor(design.geometry, design.mode)
-        scale = shape_factor(design.geometry, design.mode) / (2.0 * c)  # F = S σ / (2c)
+        s, c = factors(design)
+        scale = s / (2.0 * c)  # F = S σ / (2c)
         stresses = _time_domain_loop(design.material, design.effect_parameters, f, c * xa, points)
         forces = tuple(scale * part for part in stresses)
     else:
@@ -404,8 +431,8 @@ def loop_force(design: Design, frequency_hz: float, amplitude: float, phase):
     modulus µ(1 + ¾βε̂²); the third harmonic the closed form leaves out is drawn here)."""
     m = design.material
     effects = design.effect_parameters
-    c = strain_factor(design.geometry, design.mode)
-    scale = shape_factor(design.geometry, design.mode) / (2.0 * c)  # F = S σ / (2c)
+    s, c = factors(design)
+    scale = s / (2.0 * c)  # F = S σ / (2c)
     eps_amp = c * amplitude
     theta = np.asarray(phase, dtype=float)
     eps = eps_amp * np.sin(theta)
@@ -488,8 +515,8 @@ def force_history(design: Design, displacement, dt: float) -> HistoryResult:
         raise ValueError(f"dt: must be a positive finite number, got {dt!r}")
     _refuse_structural_effects(design, "the force history", allowed=("inertia",))
     effects = design.effect_parameters
-    c = strain_factor(design.geometry, design.mode)
-    scale = shape_factor(design.geometry, design.mode) / (2.0 * c)
+    s, c = factors(design)
+    scale = s / (2.0 * c)
     br = mat.branch_stresses(design.material, c * x, dt, effects)
     inertial = np.zeros_like(x)
     if "inertia" in effects:  # from rest at zero: x_{-1} = x_{-2} = 0

@@ -170,6 +170,23 @@ def build_parser() -> argparse.ArgumentParser:
     dg.add_argument("--predictions", metavar="PRED.csv",
                     help="write, per data row, the baseline's and the final model's |K| and loss factor")
 
+    cd = sub.add_parser(
+        "card",
+        help="every direction at one operating point: axial, radial, torsion, conical (CSV)",
+        description="The bushing card: the dynamic stiffness in the four directions at one "
+        "frequency, axial and radial at D mm, torsion and conical at R rad, with finite-length "
+        "shape factors (the design's shape 'long' keeps the closed forms for axial and torsion). "
+        "Writes CSV with columns mode, amplitude (m or rad), stiffness_real, stiffness_imag, "
+        "magnitude, loss_factor, shape_factor.",
+    )
+    cd.add_argument("design", metavar="DESIGN.json", help="design file (docs/files.md); its mode is not used")
+    cd.add_argument("--freq", required=True, type=_positive("--freq"), metavar="F", help="Hz")
+    cd.add_argument("--amp-mm", required=True, type=_positive("--amp-mm"), metavar="D",
+                    help="peak displacement of the axial and radial directions, mm")
+    cd.add_argument("--amp-rad", required=True, type=_positive("--amp-rad"), metavar="R",
+                    help="peak angle of the torsion and conical directions, rad")
+    cd.add_argument("-o", dest="output", metavar="CARD.csv", help="write here, not to stdout")
+
     return parser
 
 
@@ -331,7 +348,17 @@ def _cmd_diagnose(args) -> None:
         sys.stdout.write(summary(result))
 
 
-COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop, "fit": _cmd_fit, "diagnose": _cmd_diagnose}
+def _cmd_card(args) -> None:
+    from .card import card
+
+    design = read_design(args.design)
+    rows = card(design, args.freq, args.amp_mm * 1e-3, args.amp_rad)
+    numbers = _finite({k: np.array([r[k] for r in rows]) for k in rows[0] if k != "mode"})
+    _write_csv({"mode": [r["mode"] for r in rows], **numbers}, args.output)
+
+
+COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop, "fit": _cmd_fit, "diagnose": _cmd_diagnose,
+            "card": _cmd_card}
 
 
 def main(argv: list[str] | None = None, parser: argparse.ArgumentParser | None = None,

@@ -163,7 +163,7 @@ def csv_text(columns: dict[str, np.ndarray], number_format: str = "{:.12g}") -> 
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(columns)
     for row in zip(*columns.values()):
-        writer.writerow([number_format.format(v) for v in row])
+        writer.writerow([v if isinstance(v, str) else number_format.format(v) for v in row])
     return buf.getvalue()
 
 

@@ -28,7 +28,10 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-MODES = ("axial", "torsion")
+MODES = ("axial", "torsion", "radial", "conical")
+# shape factors: closed forms of long bushings (the thesis'), or finite-length FE (core/shape.py)
+SHAPES = ("long", "finite")
+DEFAULT_SHAPE = {"axial": "long", "torsion": "long", "radial": "finite", "conical": "finite"}
 SIZE_RANGE = (1e-6, 1e3)  # m: radii and lengths from a micrometre to a kilometre, no further
 MAX_MODULUS = 1e12  # Pa: µ, m and σ_fmax at most 1 TPa (diamond's shear modulus is about half that)
 STRAIN_HALF_RANGE = (1e-9, 10.0)  # ε½: the range the fit searches
@@ -131,7 +134,10 @@ def _frozen_effects(effects: Mapping[str, Mapping[str, float]]) -> tuple:
 
 @dataclass(frozen=True)
 class Design:
-    """A bushing: mode (``axial`` or ``torsion``), geometry and material, optionally named.
+    """A bushing: mode (``axial``, ``torsion``, ``radial`` or ``conical``), geometry and
+    material, optionally named; ``shape`` picks the shape factor (``long``: the closed forms,
+    the thesis' for axial and torsion; ``finite``: finite-length FE; ``None``: the mode's
+    default, :data:`DEFAULT_SHAPE`).
 
     ``effects`` holds the model extensions of the discrepancy workflow (docs/model.md's table,
     :mod:`core.effects`); pass a mapping ``{effect_id: {parameter: value}}``: it is validated
@@ -143,10 +149,15 @@ class Design:
     material: Material
     name: str | None = None
     effects: tuple = field(default=())
+    shape: str | None = None
 
     def __post_init__(self):
         if self.mode not in MODES:
             raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {self.mode!r}")
+        if self.shape is not None and self.shape not in SHAPES:
+            raise DesignError("shape", f"must be one of {', '.join(SHAPES)}, got {self.shape!r}")
+        if self.mode == "conical" and self.shape == "long":
+            raise DesignError("shape", "conical: no closed form holds for bushings of real length; use 'finite'")
         if not isinstance(self.geometry, Geometry):
             raise DesignError("geometry", "must be a Geometry")
         if not isinstance(self.material, Material):
@@ -154,6 +165,11 @@ class Design:
         if self.name is not None and not isinstance(self.name, str):
             raise DesignError("name", f"must be a string, got {self.name!r}")
         object.__setattr__(self, "effects", _frozen_effects(self.effects))
+
+    @property
+    def shape_kind(self) -> str:
+        """The shape factor used: ``shape``, or the mode's default."""
+        return self.shape or DEFAULT_SHAPE[self.mode]
 
     @property
     def effect_parameters(self) -> dict[str, dict[str, float]]:
@@ -177,6 +193,8 @@ class Design:
         if self.name is not None:
             out["name"] = self.name
         out["mode"] = self.mode
+        if self.shape is not None:
+            out["shape"] = self.shape
         out["geometry"] = as_dict(self.geometry)
         out["material"] = as_dict(self.material)
         if self.effects:
@@ -186,7 +204,7 @@ class Design:
 
 _GEOMETRY_KEYS = tuple(f.name for f in fields(Geometry))
 _MATERIAL_KEYS = tuple(f.name for f in fields(Material))
-_TOP_KEYS = ("name", "mode", "geometry", "material", "effects", "fit")
+_TOP_KEYS = ("name", "mode", "shape", "geometry", "material", "effects", "fit")
 
 
 def as_dict(value) -> dict[str, float]:
@@ -222,6 +240,7 @@ def design_from_dict(data: Any) -> Design:
         material=Material(**data["material"]),
         name=data.get("name"),
         effects=data.get("effects", {}),
+        shape=data.get("shape"),
     )
 
 

@@ -141,7 +141,7 @@ def test_unknown_keys_refused(where, mutate):
     assert err.key == where and "unknown key" in str(err)
 
 
-@pytest.mark.parametrize("mode", ["radial", "", 3, None])
+@pytest.mark.parametrize("mode", ["radial-ish", "", 3, None, "Axial"])
 def test_bad_mode_refused(mode):
     err = _refusal(lambda d: d.__setitem__("mode", mode))
     assert err.key == "mode" and "axial" in str(err)
@@ -207,3 +207,20 @@ def test_effects_round_trip():
 def test_bad_effects_refused(effects, key):
     err = _refusal(lambda d: d.__setitem__("effects", effects))
     assert err.key == key
+
+
+def test_every_direction_and_the_shape_round_trip():
+    from core.design import design_from_dict, dumps_design, loads_design
+
+    for mode in ("axial", "torsion", "radial", "conical"):
+        for shape in (None, "finite", "long"):
+            if mode == "conical" and shape == "long":
+                with pytest.raises(DesignError, match="shape"):
+                    PAPER_B.replace(mode=mode, shape=shape)
+                continue
+            d = PAPER_B.replace(mode=mode, shape=shape)
+            assert loads_design(dumps_design(d)) == d
+    data = PAPER_B.to_dict()
+    data["shape"] = "short"
+    with pytest.raises(DesignError, match="shape"):
+        design_from_dict(data)

@@ -30,7 +30,7 @@ def _fmt_freq(f: float) -> str:
 
 
 def _amplitude_formatter(mode: str) -> Callable[[float], str]:
-    if mode == "axial":
+    if mode in ("axial", "radial"):
         return lambda x: f"{x * 1e3:.3g} mm"
     return lambda x: f"{x:.3g} rad"
 

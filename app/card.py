@@ -1,0 +1,100 @@
+"""The "Every direction" tab: the bushing card. The four stiffnesses at the operating frequency,
+axial and radial at a displacement, torsion and conical at an angle, the ratios engineers quote,
+and |K| and the loss factor against amplitude in every direction."""
+
+from __future__ import annotations
+
+import panel as pn
+import param
+
+from core.card import card, card_design, ratios
+from core.shape import long_shape_factor
+
+from . import plots, units
+from .curves import card_sweeps, padded
+from .live import LivePlot
+from .state import ExplorerState
+from .views import PlotView
+
+WHICH = ("translation", "rotation", "loss")
+TEXT = """
+**Every direction of the bushing.** The same rubber and geometry loaded four ways: **axial** (the
+sleeves moved apart along the axis), **radial** (across it), **torsion** (turned about it) and
+**conical** (tilted about a diameter). Finite-length shape factors from the finite-element table
+(the design's long-bushing setting keeps the thesis' formulas for axial and torsion); each
+direction has its own equivalent strain, so the Fletcher–Gent softening differs between them.
+"""
+
+
+class CardView(PlotView):
+    """The bushing card at the operating frequency."""
+
+    displacement_mm = param.Number(0.1, bounds=(1e-6, 100.0), label="Displacement amplitude (mm)")
+    angle_rad = param.Number(0.01, bounds=(1e-7, 1.0), label="Angle amplitude (rad)")
+
+    def __init__(self, state: ExplorerState, **params):
+        super().__init__(state, **params)
+        self.inputs = pn.Row(
+            pn.widgets.FloatInput.from_param(self.param.displacement_mm, start=1e-6, end=100.0, step=0.01),
+            pn.widgets.FloatInput.from_param(self.param.angle_rad, start=1e-7, end=1.0, step=0.001),
+            sizing_mode="stretch_width")
+        self.table = pn.pane.Markdown("", sizing_mode="stretch_width")
+        self.dims = plots.card_dimensions()
+        self.plots: LivePlot | None = None
+        self._update()
+
+    @param.depends("state.design", "state.errors", "state.frequency_hz", "displacement_mm", "angle_rad", watch=True)
+    def _on_state(self):
+        self.changed()
+
+    def frame(self, which: str):
+        return self.plots.current[WHICH.index(which)]
+
+    def _update(self):
+        design, f = self.state.design, self.state.frequency_hz
+        x, angle = self.displacement_mm * 1e-3, self.angle_rad
+        try:
+            rows = card(design, f, x, angle)
+            data = card_sweeps(design, f)
+        except ValueError as exc:  # outside the finite-length table, or an effect with no card
+            self.table.object = f"_The card is not available for this design: {exc}_"
+            return
+        self.table.object = self.summary(design, f, rows)
+        for which, modes in (("translation", ("axial", "radial")), ("rotation", ("torsion", "conical"))):
+            dim = self.dims["displacement" if which == "translation" else "angle"]
+            dim.range = padded([data[m]["amplitude"] for m in modes], log=True)
+        at = {"translation": units.display_amplitude(x, "axial"), "rotation": units.display_amplitude(angle, "torsion")}
+        overlays = plots.card_overlays(data, self.dims, at)
+        items = [overlays[w] for w in WHICH]
+        if self.plots is None:
+            self.plots = LivePlot(items)
+        else:
+            self.plots.show(items)
+
+    @staticmethod
+    def summary(design, frequency_hz, rows) -> str:
+        g = design.geometry
+        lines = [f"**At {frequency_hz:.3g} Hz** ({design.name or 'this design'})", "",
+                 "| direction | amplitude | \\|K\\| | loss factor | shape factor S | S / long-bushing formula |",
+                 "|---|---|---|---|---|---|"]
+        for r in rows:
+            mode = r["mode"]
+            amp = units.display_amplitude(r["amplitude"], mode)
+            k = units.display_stiffness(r["magnitude"], mode)
+            s_unit = "m" if mode in ("axial", "radial") else "m³"
+            try:
+                versus = f"{r['shape_factor'] / long_shape_factor(g.inner_radius, g.outer_radius, g.length, mode):.3f}"
+            except ValueError:
+                versus = "no formula"
+            used = card_design(design, mode).shape_kind
+            lines.append(f"| {mode} ({used}) | {amp:.3g} {units.amplitude_unit(mode)} | {k:.4g} "
+                         f"{units.stiffness_unit(mode)} | {r['loss_factor']:.4f} | {r['shape_factor']:.4g} {s_unit} "
+                         f"| {versus} |")
+        q = ratios(design, rows)
+        lines += ["", (f"**Ratios**: radial / axial **{q['radial/axial']:.2f}**; radial / torsion-equivalent "
+                       f"(K_torsion / r_m², r_m = (a + b)/2) **{q['radial/torsion-equivalent']:.2f}**.")]
+        return "\n".join(lines)
+
+    def __panel__(self):
+        return pn.Column(pn.pane.Markdown(TEXT, sizing_mode="stretch_width"), self.inputs, self.table,
+                         *self.plots.panes, sizing_mode="stretch_width")

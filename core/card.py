@@ -1,0 +1,47 @@
+"""The bushing card: the dynamic stiffness in every direction at one operating point.
+
+Axial and radial at a displacement amplitude, torsion and conical at an angle amplitude, all from
+the same material and geometry, with finite-length shape factors (a design whose ``shape`` is
+``long`` keeps the closed forms for axial and torsion; radial and conical are always finite, the
+plane-strain radial formula being about twice too stiff for real lengths). Plus the ratios
+engineers quote: radial / axial, and radial / the torsion-equivalent translational stiffness
+K_torsion / r_m², r_m = (a + b)/2 (the circumferential stiffness at the mean radius).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .bushing import factors, stiffness_points
+from .data import loss_factor
+from .design import Design
+from .shape import TRANSLATIONS
+
+CARD_MODES = ("axial", "radial", "torsion", "conical")
+
+
+def card_design(design: Design, mode: str) -> Design:
+    """``design`` in ``mode`` with the card's shape factor."""
+    shape = design.shape if design.shape == "long" and mode in ("axial", "torsion") else "finite"
+    return design.replace(mode=mode, shape=shape)
+
+
+def card(design: Design, frequency_hz: float, displacement: float, angle: float) -> list[dict]:
+    """One row per direction: mode, amplitude (m or rad), the complex stiffness, |K|, the loss
+    factor and the shape factor used (m or m³)."""
+    rows = []
+    for mode in CARD_MODES:
+        d = card_design(design, mode)
+        x = displacement if mode in TRANSLATIONS else angle
+        k = complex(stiffness_points(d, frequency_hz, x))
+        rows.append({"mode": mode, "amplitude": float(x), "stiffness_real": k.real, "stiffness_imag": k.imag,
+                     "magnitude": abs(k), "loss_factor": float(loss_factor(np.array([k]))[0]),
+                     "shape_factor": factors(d)[0]})
+    return rows
+
+
+def ratios(design: Design, rows: list[dict]) -> dict[str, float]:
+    """radial/axial and radial/(K_torsion / r_m²) of the card's |K|."""
+    k = {r["mode"]: r["magnitude"] for r in rows}
+    r_m = 0.5 * (design.geometry.inner_radius + design.geometry.outer_radius)
+    return {"radial/axial": k["radial"] / k["axial"], "radial/torsion-equivalent": k["radial"] / (k["torsion"] / r_m**2)}

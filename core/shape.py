@@ -1,0 +1,247 @@
+"""Shape factors of a bushing in every direction, and the energy-balance equivalent strain.
+
+The stiffness separates into geometry and material, K_mode = S_mode · µ_eq(ω, ε_eq), with S_mode
+the shape factor: m for the translations (axial, radial), m³ for the rotations (torsion about
+the axis, conical: tilting about a diameter). Symbols: a inner, b outer radius, L length.
+
+Closed forms (docs/model.md), for infinitely long bushings except torsion, which is exact at any
+length (the free ends carry no traction in the exact solution):
+
+* axial, long:   S = 2πL / ln(b/a)                                        (thesis eq 18)
+* torsion:       S = 4π a² b² L / (b² − a²)                               (thesis eq 17)
+* radial, long (plane strain, incompressible):
+                 S = 4πL (a² + b²) / ((a² + b²) ln(b/a) − (b² − a²))
+* conical: no closed form holds for real lengths; :func:`conical_reference` (the long radial
+  stiffness per length, summed with the lever arm², S_radial,long · L²/12) is only the scale
+  the finite-length table is divided by.
+
+Finite lengths come from a finite-element model (:func:`fe_shape_factor`, the felupe library):
+the rubber between rigid bonded tubes, the outer one held, the inner one moved rigidly by a small
+displacement or rotation, the ends free; nearly incompressible (bulk modulus 5000 µ, Hu-Washizu
+three-field hexahedra); a quarter of the bushing by its two planes of symmetry. Two meshes and
+Richardson's extrapolation (the error falls as h²) give the converged value
+(:func:`converged_shape_factor`). A table of the converged ratios to the closed forms over
+(b/a, L/(b − a)), made by ``tools/shape_table.py`` and shipped as ``core/shape_table.json``, is
+interpolated by bicubic splines in the logarithms (:func:`finite_shape_factor`).
+
+The equivalent strain of any mode follows from the energy balance with a simple-shear specimen
+(strain-energy density 2µε² at tensor shear strain ε): the bushing stores ½ S µ x̂², so
+
+    ε_eq = x̂ · √(S / (4V)),     V = π (b² − a²) L,
+
+which is the thesis' eq 15 with the long axial S and its eq 14 with the torsion S.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+MODES = ("axial", "torsion", "radial", "conical")
+TRANSLATIONS = ("axial", "radial")  # amplitude in m, stiffness in N/m
+ROTATIONS = ("torsion", "conical")  # amplitude in rad, stiffness in N·m/rad
+SHAPES = ("long", "finite")  # closed forms of long bushings, or the finite-length table
+DEFAULT_SHAPE = {"axial": "long", "torsion": "long", "radial": "finite", "conical": "finite"}
+TABLE_PATH = Path(__file__).with_name("shape_table.json")
+BULK_RATIO = 5000.0  # K/µ of the FE model: rubber's is 1 000–5 000
+VERBOSE = 0
+
+
+class OutsideTable(ValueError):
+    """A geometry outside the finite-length table."""
+
+
+def _radii(a: float, b: float, L: float):
+    if not (a > 0 and b > a and L > 0):
+        raise ValueError(f"shape factor: needs 0 < a < b and L > 0, got a={a:g}, b={b:g}, L={L:g}")
+    return float(a), float(b), float(L)
+
+
+def long_shape_factor(a: float, b: float, L: float, mode: str) -> float:
+    """The closed form of ``mode`` (torsion exact; axial and radial for a long bushing)."""
+    a, b, L = _radii(a, b, L)
+    if mode == "axial":
+        return 2.0 * math.pi * L / math.log(b / a)
+    if mode == "torsion":
+        return 4.0 * math.pi * a * a * b * b * L / (b * b - a * a)
+    if mode == "radial":
+        s = a * a + b * b
+        return 4.0 * math.pi * L * s / (s * math.log(b / a) - (b * b - a * a))
+    if mode == "conical":
+        raise ValueError("conical: no closed form holds for bushings of real length; use shape 'finite'")
+    raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
+
+
+def conical_reference(a: float, b: float, L: float) -> float:
+    """The scale of the conical shape factor: the long radial stiffness per length with the
+    lever arm² summed over the length, S_radial,long · L²/12 (m³). Not a stiffness formula."""
+    return long_shape_factor(a, b, L, "radial") * L * L / 12.0
+
+
+def reference_shape_factor(a: float, b: float, L: float, mode: str) -> float:
+    """What the finite-length table's ratios are relative to."""
+    return conical_reference(a, b, L) if mode == "conical" else long_shape_factor(a, b, L, mode)
+
+
+def strain_factor_from_shape(S: float, a: float, b: float, L: float) -> float:
+    """c in ε_eq = c · x̂ from the energy balance: √(S / (4V)), V = π(b² − a²)L."""
+    return math.sqrt(S / (4.0 * math.pi * (b * b - a * a) * L))
+
+
+# ---- the finite-element model -------------------------------------------------------------
+
+# components held at zero on the symmetry planes x = 0 (the mid-length) and z = 0 (through the
+# axis, containing the load), per mode: the loads are symmetric or antisymmetric about each
+_HELD = {
+    "axial": ((0, 1, 1), (0, 0, 1)),
+    "radial": ((1, 0, 0), (0, 0, 1)),
+    "conical": ((0, 1, 1), (0, 0, 1)),
+    "torsion": ((1, 0, 0), (1, 1, 0)),
+}
+
+
+def _axial_nodes(half_length: float, h: float, wall: float, n: int) -> np.ndarray:
+    """Nodes from the mid-plane (0) to the free end: elements of size h within one wall
+    thickness of the end, then growing by 1.25 toward the middle, at most 4h; at least n
+    elements along a short bushing."""
+    sizes, total = [], 0.0
+    size = h = min(h, half_length / n)
+    while total < half_length - 1e-12 * half_length:
+        sizes.append(size)
+        total += size
+        if total >= wall:
+            size = min(size * 1.25, 4 * h)
+    sizes = np.array(sizes) * half_length / total
+    return np.concatenate([[0.0], np.cumsum(sizes[::-1])])
+
+
+def fe_shape_factor(a: float, b: float, L: float, mode: str, n_r: int = 6) -> tuple[float, int]:
+    """S of ``mode`` from the felupe model with ``n_r`` elements across the wall (4 n_r around
+    the half circumference, graded along the length); the number of hexahedra of the quarter."""
+    import felupe as fem  # the FE library: only here, for the table and its checks
+
+    a, b, L = _radii(a, b, L)
+    h = (b - a) / n_r
+    x_nodes = _axial_nodes(L / 2, h, b - a, n_r)
+    rect = fem.mesh.Grid(x_nodes, np.linspace(a, b, n_r + 1))
+    mesh = rect.revolve(n=4 * n_r + 1, phi=180, axis=0)
+    field = fem.FieldsMixed(fem.RegionHexahedron(mesh), n=3)
+    x = mesh.points
+    r = np.hypot(x[:, 1], x[:, 2])
+    inner, outer = np.isclose(r, a, rtol=1e-9), np.isclose(r, b, rtol=1e-9)
+    p = x[inner]
+    zero = np.zeros(len(p))
+    step = 1e-6 * (b - a)  # small: the response is linear
+    if mode == "axial":
+        u = np.column_stack([zero + step, zero, zero])
+    elif mode == "radial":
+        u = np.column_stack([zero, zero + step, zero])
+    elif mode == "torsion":  # about the axis x
+        angle = step / b
+        u = np.column_stack([zero, -angle * p[:, 2], angle * p[:, 1]])
+    elif mode == "conical":  # about the diameter z, through the centre
+        angle = step / L
+        u = np.column_stack([-angle * p[:, 1], angle * p[:, 0], zero])
+    else:
+        raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
+    held_mid, held_plane = _HELD[mode]
+    free = ~inner & ~outer
+    boundaries = {
+        "outer": fem.Boundary(field[0], mask=outer),
+        "inner": fem.Boundary(field[0], mask=inner, value=u.ravel()),
+        "mid": fem.Boundary(field[0], mask=np.isclose(x[:, 0], 0.0) & free, skip=tuple(1 - k for k in held_mid)),
+        "plane": fem.Boundary(field[0], mask=np.isclose(x[:, 2], 0.0) & free,
+                              skip=tuple(1 - k for k in held_plane)),
+    }
+    # µ of a rubber (1 MPa), so that the reaction forces are far above felupe's absolute floor
+    # (1e-3) in its relative convergence test; S = reaction / (µ · step)
+    mu = 1e6 / max(a, 1e-300) ** 2
+    solid = fem.SolidBody(fem.ThreeFieldVariation(fem.NeoHooke(mu=mu, bulk=BULK_RATIO * mu)), field)
+    dof0, dof1 = fem.dof.partition(field, boundaries)
+    ext0 = fem.dof.apply(field, boundaries, dof0)
+    # the problem is linear (a step of 1e-6 of the wall): Newton converges in one or two
+    # iterations to the round-off floor of the nearly incompressible system (about 1e-8)
+    res = fem.newtonraphson(items=[solid], x0=field, dof1=dof1, dof0=dof0, ext0=ext0, verbose=VERBOSE, tol=1e-6)
+    # the quarter's reaction on the inner tube, times 4 (the other quarters mirror it)
+    if mode in TRANSLATIONS:
+        force = fem.tools.force(field, res.fun, boundaries["inner"])
+        return 4.0 * float(force[0] if mode == "axial" else force[1]) / (mu * step), mesh.ncells
+    moment = fem.tools.moment(field, res.fun, boundaries["inner"], centerpoint=np.zeros(3))
+    return 4.0 * float(moment[0] if mode == "torsion" else moment[2]) / (mu * angle), mesh.ncells
+
+
+@dataclass(frozen=True)
+class Converged:
+    value: float  # Richardson's extrapolation of the two meshes
+    coarse: float
+    fine: float
+    cells: int  # of the finer quarter model
+
+    @property
+    def error(self) -> float:
+        """The estimated relative error of the finer mesh (its distance to the extrapolation)."""
+        return abs(self.fine - self.value) / abs(self.value)
+
+
+def converged_shape_factor(a: float, b: float, L: float, mode: str, levels: tuple[int, int] = (6, 8)) -> Converged:
+    """S from two meshes (``levels`` elements across the wall) and Richardson's extrapolation
+    with the observed order 2 (checked on three meshes in the tests)."""
+    n1, n2 = levels
+    s1, _ = fe_shape_factor(a, b, L, mode, n1)
+    s2, cells = fe_shape_factor(a, b, L, mode, n2)
+    w = (1 / n2**2) / (1 / n1**2 - 1 / n2**2)
+    return Converged(s2 - w * (s1 - s2), s1, s2, cells)
+
+
+# ---- the table ------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ShapeTable:
+    radius_ratio: np.ndarray  # b/a
+    length_ratio: np.ndarray  # L/(b − a)
+    ratios: dict  # mode → array (radius_ratio × length_ratio) of S_FE / S_reference
+
+    def ratio(self, mode: str, radius_ratio: float, length_ratio: float) -> float:
+        lo_r, hi_r = self.radius_ratio[[0, -1]]
+        lo_l, hi_l = self.length_ratio[[0, -1]]
+        if not (lo_r <= radius_ratio <= hi_r and lo_l <= length_ratio <= hi_l):
+            raise OutsideTable(
+                f"the finite-length shape factors cover b/a {lo_r:g}–{hi_r:g} and L/(b − a) {lo_l:g}–{hi_l:g}; "
+                f"this bushing has b/a {radius_ratio:.3g} and L/(b − a) {length_ratio:.3g} (use shape 'long' "
+                f"for axial or torsion)")
+        # the spline interpolates ln(ratio): its exp stays positive and smooth
+        return math.exp(float(self._spline(mode)(math.log(radius_ratio), math.log(length_ratio))[0, 0]))
+
+    @functools.cache  # noqa: B019 - one table per process, a spline per mode
+    def _spline(self, mode: str):
+        from scipy.interpolate import RectBivariateSpline
+
+        return RectBivariateSpline(np.log(self.radius_ratio), np.log(self.length_ratio),
+                                   np.log(self.ratios[mode]), kx=3, ky=3, s=0)
+
+    def __hash__(self):
+        return id(self)
+
+
+@functools.cache
+def table() -> ShapeTable:
+    data = json.loads(TABLE_PATH.read_text(encoding="utf-8"))
+    return ShapeTable(np.array(data["radius_ratio"]), np.array(data["length_ratio"]),
+                      {m: np.array(v) for m, v in data["ratios"].items()})
+
+
+def finite_shape_factor(a: float, b: float, L: float, mode: str) -> float:
+    """S of a bushing of real length: the table's converged FE ratio times the reference
+    (torsion: its exact formula, which the FE reproduces)."""
+    a, b, L = _radii(a, b, L)
+    if mode == "torsion":
+        return long_shape_factor(a, b, L, "torsion")
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
+    return reference_shape_factor(a, b, L, mode) * table().ratio(mode, b / a, L / (b - a))

@@ -1,0 +1,74 @@
+"""The explorer in every direction: radial and conical modes, the finite-length switch with how
+far it is from the closed form, a geometry outside the shape-factor table, and the bushing card
+tab holding the core's numbers."""
+
+import numpy as np
+import pytest
+
+from app import units
+from app.main import App
+from core import PAPER_B, stiffness
+from core.bushing import shape_factor, strain_factor
+from core.card import card
+from tests.helpers import xy
+
+
+@pytest.fixture
+def app():
+    return App()
+
+
+@pytest.mark.parametrize("mode, unit", [("radial", "mm"), ("conical", "rad")])
+def test_radial_and_conical_modes_draw_the_core_stiffness(app, mode, unit):
+    s = app.state
+    s.amplitude = 0.2  # mm, axial
+    eps = strain_factor(s.design.geometry, "axial") * 0.2e-3
+    s.mode = mode
+    assert s.design.mode == mode and s.design.shape_kind == "finite" and s.errors == {}
+    assert s.amplitude_unit == unit
+    assert strain_factor(s.design.geometry, mode) * units.to_si_amplitude(s.amplitude, mode) == pytest.approx(eps,
+                                                                                                           rel=1e-2)
+    x, y = xy(app.plots.frame(("magnitude", "amplitude")), "operating point")
+    expected = stiffness(s.design, s.frequency_hz, units.to_si_amplitude(x, mode)).magnitude[:, 0]
+    np.testing.assert_allclose(units.display_stiffness(expected, mode), y, rtol=1e-9)
+    assert app.inputs.finite_length.disabled
+    assert "Finite-length S" in app.inputs.shape_note.object or "Conical S" in app.inputs.shape_note.object
+
+
+def test_the_finite_length_switch_and_its_comparison(app):
+    s = app.state
+    assert s.design.shape is None and "in use: the long-bushing formula" in app.inputs.shape_note.object
+    g = s.design.geometry
+    ratio = shape_factor(g, "axial", "finite") / shape_factor(g, "axial", "long")
+    assert f"{ratio:.3f} of the long-bushing formula" in app.inputs.shape_note.object
+    s.finite_length = True
+    assert s.design.shape == "finite" and "in use: the finite-element" in app.inputs.shape_note.object
+    x, y = xy(app.plots.frame(("magnitude", "amplitude")), "operating point")
+    expected = stiffness(PAPER_B.replace(shape="finite"), s.frequency_hz, units.to_si_amplitude(x, "axial"))
+    np.testing.assert_allclose(units.display_stiffness(expected.magnitude[:, 0], "axial"), y, rtol=1e-9)
+
+
+def test_a_geometry_outside_the_table_is_a_message_not_a_crash(app):
+    s = app.state
+    s.mode = "radial"
+    s.length_mm = 5000.0  # L/(b − a) = 333: beyond the table
+    assert "length_mm" in s.errors and "L/(b − a)" in s.errors["length_mm"]
+    assert s.design.geometry.length == pytest.approx(0.09)  # the last good design stays
+    s.length_mm = 90.0
+    assert s.errors == {}
+
+
+def test_the_card_tab_holds_the_core_card(app):
+    view = app.card
+    app.tabs.active = [t for t, *_ in App.LAZY_TABS].index("Every direction") + 1  # shown: it refreshes
+    view.param.update(displacement_mm=0.2, angle_rad=0.02)
+    rows = card(app.state.design, app.state.frequency_hz, 0.2e-3, 0.02)
+    for r in rows:
+        assert f"{units.display_stiffness(r['magnitude'], r['mode']):.4g}" in view.table.object
+    radial = next(r for r in rows if r["mode"] == "radial")["magnitude"]
+    axial = next(r for r in rows if r["mode"] == "axial")["magnitude"]
+    assert f"radial / axial **{radial / axial:.2f}**" in view.table.object
+    x, y = xy(view.frame("translation"), "radial")
+    assert len(x) == 60 and np.all(np.diff(y) < 0)  # the radial stiffness softens with amplitude
+    _, eta = xy(view.frame("loss"), "conical")
+    assert np.all(np.isfinite(eta))
