@@ -16,13 +16,14 @@ from .live import LivePlot
 from .state import ExplorerState
 from .views import PlotView
 
-WHICH = ("translation", "rotation", "loss")
+WHICH = ("translation", "translation_loss", "rotation", "rotation_loss")
 TEXT = """
 **Every direction of the bushing.** The same rubber and geometry loaded four ways: **axial** (the
 sleeves moved apart along the axis), **radial** (across it), **torsion** (turned about it) and
 **conical** (tilted about a diameter). Finite-length shape factors from the finite-element table
 (the design's long-bushing setting keeps the thesis' formulas for axial and torsion); each
-direction has its own equivalent strain, so the Fletcher–Gent softening differs between them.
+direction has its own equivalent strain, so the Fletcher–Gent softening sets in at a different
+drive in each (at the same equivalent strain, the loss factors are the same: one material).
 """
 
 
@@ -97,4 +98,4 @@ class CardView(PlotView):
 
     def __panel__(self):
         return pn.Column(pn.pane.Markdown(TEXT, sizing_mode="stretch_width"), self.inputs, self.table,
-                         *self.plots.panes, sizing_mode="stretch_width")
+                         self.plots.grid(2), sizing_mode="stretch_width")

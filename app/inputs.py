@@ -156,8 +156,7 @@ class DesignInputs(pn.viewable.Viewer):
         return pn.Column(
             self.preset,
             self.mode,
-            pn.Row(self.finite_length, pn.pane.Markdown("Finite-length shape factor", margin=(6, 4)),
-                   sizing_mode="stretch_width"),
+            self.finite_length,
             self.shape_note,
             pn.pane.Markdown("**Operating point**", margin=(8, 10, 0, 10)),
             self.amplitude,

@@ -480,44 +480,40 @@ CARD_COLORS = {"axial": "#1f77b4", "radial": "#d62728", "torsion": "#2ca02c", "c
 
 
 def card_dimensions() -> dict[str, hv.Dimension]:
-    """The card's axes: translations and rotations apart (their units differ), the loss factor
-    against the equivalent strain that all four directions share."""
+    """The card's axes: translations and rotations apart (their units differ)."""
     return {
         "displacement": hv.Dimension("card_displacement", label="Displacement amplitude",
                                      unit=units.amplitude_unit("axial")),
         "angle": hv.Dimension("card_angle", label="Angle amplitude", unit=units.amplitude_unit("torsion")),
         "k_translation": hv.Dimension("card_k_translation", label="|K|", unit=units.stiffness_unit("axial")),
         "k_rotation": hv.Dimension("card_k_rotation", label="|K|", unit=units.stiffness_unit("torsion")),
-        "strain": hv.Dimension("card_strain", label="Equivalent strain amplitude"),
         "loss": hv.Dimension("card_loss", label="Loss factor"),
     }
 
 
 def card_overlays(data: dict, dims: dict, at: dict) -> dict:
-    """The card (:func:`app.curves.card_sweeps`) as three plots: |K| of the translations
-    against displacement, of the rotations against angle, every loss factor against the
-    equivalent strain; ``at`` the card's displacement, angle and their strains."""
+    """The card (:func:`app.curves.card_sweeps`) as four plots: |K| and the loss factor of the
+    translations against displacement, of the rotations against angle; ``at`` the card's
+    displacement and angle (display units)."""
     out = {}
     for which, modes, xdim, ydim, title in (
             ("translation", ("axial", "radial"), dims["displacement"], dims["k_translation"],
-             "|K| across and along the axis"),
+             "|K| along and across the axis"),
             ("rotation", ("torsion", "conical"), dims["angle"], dims["k_rotation"], "|K| turning and tilting")):
-        items = [_curve(data[m]["amplitude"], data[m]["magnitude"], xdim, ydim, m, color=CARD_COLORS[m],
-                        line_width=2) for m in modes]
-        items.append(marker(at[which], xdim))
-        out[which] = _overlay(items, title, f"bushing-card-{which}", logx=True, height=280)
-    items = [_curve(data["strain"], data[m]["loss_factor"], dims["strain"], dims["loss"], m, color=CARD_COLORS[m],
-                    line_width=2) for m in CARD_COLORS]
-    out["loss"] = _overlay(items, "Loss factor in every direction, at the same equivalent strain",
-                           "bushing-card-loss", logx=True, height=280)
+        for quantity, y_dim, name in (("magnitude", ydim, which), ("loss_factor", dims["loss"], f"{which}_loss")):
+            items = [_curve(data[m]["amplitude"], data[m][quantity], xdim, y_dim, m, color=CARD_COLORS[m],
+                            line_width=2) for m in modes]
+            items.append(marker(at[which], xdim))
+            label = title if quantity == "magnitude" else f"Loss factor, {title[4:]}"
+            out[name] = _overlay(items, label, f"bushing-card-{name.replace('_', '-')}", logx=True, height=260)
     return out
 
 
 def card_plots(design: Design, frequency_hz: float = 10.0, displacement: float = 1e-4, angle: float = 0.01, *,
                width: int | None = 800) -> hv.Layout:
-    """The bushing card's three plots for ``design`` at ``frequency_hz``; the markers at the
+    """The bushing card's four plots for ``design`` at ``frequency_hz``; the markers at the
     card's displacement (m) and angle (rad)."""
     data = curves.card_sweeps(design, frequency_hz)
     at = {"translation": units.display_amplitude(displacement, "axial"),
           "rotation": units.display_amplitude(angle, "torsion")}
-    return sized(hv.Layout(list(card_overlays(data, card_dimensions(), at).values())).cols(1), width)
+    return sized(hv.Layout(list(card_overlays(data, card_dimensions(), at).values())).cols(2), width)
