@@ -72,3 +72,26 @@ def test_the_card_tab_holds_the_core_card(app):
     assert len(x) == 60 and np.all(np.diff(y) < 0)  # the radial stiffness softens with amplitude
     _, eta = xy(view.frame("rotation_loss"), "conical")
     assert np.all(np.isfinite(eta)) and eta.max() > eta[0]  # the loss factor's Fletcher–Gent peak
+
+
+def test_exports_and_the_plotting_api_in_a_new_direction(app):
+    """The design file and the stiffness table of a conical, finite-length design: the public
+    formats, the core's numbers; the card's plots from the plotting API."""
+    import csv
+    import io
+
+    import holoviews as hv
+
+    from app.plots import card_plots
+    from core import loads_design
+
+    app.state.mode = "conical"
+    design = loads_design(app.export._design_json().getvalue())
+    assert design == app.state.design and design.mode == "conical" and design.shape_kind == "finite"
+    rows = list(csv.reader(io.StringIO(app.export._table_csv().getvalue())))
+    values = np.array(rows[1:], dtype=float)
+    ref = stiffness(design, values[:, 0], values[0, 1])
+    first = values[:, 1] == values[0, 1]
+    np.testing.assert_allclose(values[first, 4], ref.magnitude[0, first], rtol=1e-10)
+    layout = card_plots(PAPER_B, 10.0)
+    assert isinstance(layout, hv.Layout) and len(layout) == 4

@@ -429,3 +429,18 @@ def test_bokehjs_paint_patches_keep_bokehs_behaviour(page, explorer_url):
     before, themed, after = page.evaluate(CSS_THEME_JS, "|K| against frequency")
     assert themed == "rgb(1, 2, 3)"
     assert before == after != themed
+
+
+def test_every_direction_from_a_link(page, explorer_url):
+    """A link to a radial, finite-length design: the mode and the switch come back, and the
+    Every direction tab draws its card."""
+    open_explorer(page, explorer_url + "?mode=radial&finite=true")
+    assert page.get_by_role("button", name="radial").get_attribute("class").count("bk-active") == 1
+    page.get_by_text("Finite-length S is 0.482 of the long-bushing formula").wait_for(timeout=10000)
+    page.get_by_text("Every direction", exact=True).click()
+    page.get_by_text("radial (finite)").wait_for(timeout=20000)
+    page.get_by_text("Ratios").wait_for(timeout=5000)
+    wait_quiet(page)
+    shown = plots(page)
+    assert shown["|K| along and across the axis"]["points"] >= 2 * 60
+    assert shown["Loss factor, turning and tilting"]["points"] >= 2 * 60
