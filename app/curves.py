@@ -174,9 +174,19 @@ def padded(values, log: bool = False, pad: float = PADDING) -> tuple[float, floa
 DISPLAY_POINTS = 5000
 
 
+def in_mode(measured: MeasuredStiffness | None, mode: str) -> MeasuredStiffness | None:
+    """The rows of ``measured`` in ``mode`` (all of a file without a mode column); None if none."""
+    if measured is None or measured.mode is None:
+        return measured
+    rows = measured.mode == mode
+    return measured.select(rows) if rows.any() else None
+
+
 def measured_points(measured: MeasuredStiffness | None, mode: str) -> dict | None:
     """Measured stiffness (SI) in display units, as the sweep plots draw it (dense data as the
-    means of at most :data:`DISPLAY_POINTS` bins, :meth:`MeasuredStiffness.binned`)."""
+    means of at most :data:`DISPLAY_POINTS` bins, :meth:`MeasuredStiffness.binned`); only the
+    rows in ``mode``."""
+    measured = in_mode(measured, mode)
     if measured is None:
         return None
     measured = measured.binned(DISPLAY_POINTS)
@@ -186,9 +196,13 @@ def measured_points(measured: MeasuredStiffness | None, mode: str) -> dict | Non
             "loss_factor": measured.loss_factor}
 
 
-def measured_residuals(design: Design, measured: MeasuredStiffness) -> dict:
+def measured_residuals(design: Design, measured: MeasuredStiffness) -> dict | None:
     """``design`` at each measured point against the data: |K| in %, the loss factor (at the
-    points :func:`measured_points` draws), the gap (over every measured point)."""
+    points :func:`measured_points` draws), the gap (over every measured point); the rows in the
+    design's mode only (None if there are none)."""
+    measured = in_mode(measured, design.mode)
+    if measured is None:
+        return None
     k = stiffness_points(design, measured.frequency_hz, measured.amplitude)
     shown = measured.binned(DISPLAY_POINTS)
     k_shown = k if shown is measured else stiffness_points(design, shown.frequency_hz, shown.amplitude)

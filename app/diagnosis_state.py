@@ -3,6 +3,8 @@ plots' data. No Panel import: the view (:mod:`app.diagnosis`) is thin."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import param
 
@@ -77,7 +79,14 @@ class DiagnosisState(param.Parameterized):
         if not self.baseline:
             raise ValueError("choose at least one baseline branch")
         design = self.explorer.design.replace(effects={})
-        return diagnose(design, self.data, baseline=[b for b in BRANCHES if b in self.baseline], progress=progress)
+        data = self.data
+        if data.mode is not None:  # one direction at a time: the explorer's
+            rows = data.mode == design.mode
+            if not rows.any():
+                raise ValueError(f"the data hold no {design.mode} rows (they hold {', '.join(sorted(set(data.mode)))}): "
+                                 "switch the explorer's mode")
+            data = dataclasses.replace(data.select(rows), mode=None)
+        return diagnose(design, data, baseline=[b for b in BRANCHES if b in self.baseline], progress=progress)
 
     def use_final(self):
         """Take the final model into the explorer, keeping the operating point."""

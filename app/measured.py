@@ -15,11 +15,11 @@ from core import PAPER_B
 from core.fit import PARAMETERS
 from core.synthetic import paper_b_example
 
-from . import plots
+from . import curves, plots
 from .curves import padded
 from .live import LivePlot
 from .state import ExplorerState
-from .uploads import csv_dropper, on_upload
+from .uploads import csv_dropper, on_files, on_upload
 from .views import PlotView
 
 RESIDUALS = (("magnitude", "frequency"), ("loss", "frequency"), ("magnitude", "amplitude"), ("loss", "amplitude"))
@@ -40,9 +40,9 @@ class MeasuredView(PlotView):
 
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
-        self.stiffness_file = csv_dropper()
+        self.stiffness_file = csv_dropper(multiple=True)
         self.loop_file = csv_dropper()
-        on_upload(self.stiffness_file, state.load_measured)
+        on_files(self.stiffness_file, state.load_measured_files)
         on_upload(self.loop_file, state.load_measured_loop)
         self.example = pn.widgets.Button(label="Load the synthetic Paper B example", color="light")
         self.example.on_click(self._load_example)
@@ -53,6 +53,9 @@ class MeasuredView(PlotView):
                                             "the current design is the first.")
         self.fit_button.on_click(self._fit)
         self.method = pn.widgets.RadioButtonGroup.from_param(state.param.fit_method, description=state.param.fit_method.doc)
+        self.fit_on = pn.widgets.TextInput.from_param(state.param.fit_on, description=state.param.fit_on.doc,
+                                                      placeholder="mode=axial,amplitude=1e-4", max_length=500,
+                                                      sizing_mode="stretch_width")
         self.sweep = pn.widgets.Select(label="Sweep amplitude (two-step)", options={}, sizing_mode="stretch_width",
                                        description=state.param.sweep_amplitude.doc)
         self.sweep.param.watch(lambda e: setattr(state, "sweep_amplitude", e.new), "value")
@@ -102,11 +105,19 @@ class MeasuredView(PlotView):
         lines = []
         if s.measured is not None:
             d = s.measured
-            lines.append(f"**Stiffness**: {len(d)} points, {d.frequency_hz.min():.3g}–{d.frequency_hz.max():.3g} Hz, "
-                         f"amplitudes {points['amplitude'].min():.3g}–{points['amplitude'].max():.3g} {s.amplitude_unit}; "
-                         f"gap of the current design: **{residuals['gap']:.4f}**"
-                         + (f" (drawn as {len(points['frequency_hz'])} bin means; fits bin them too)"
-                            if len(points["frequency_hz"]) < len(d) else ""))
+            modes = "" if d.mode is None else f" in {', '.join(sorted(set(d.mode)))}"
+            if points is None:
+                lines.append(f"**Stiffness**: {len(d)} points{modes}; none in the explorer's mode "
+                             f"({s.design.mode}): switch the mode to see them. The fit uses every mode.")
+            else:
+                shown = "" if d.mode is None else f" ({int((d.mode == s.design.mode).sum())} {s.design.mode} shown)"
+                lines.append(
+                    f"**Stiffness**: {len(d)} points{modes}{shown}, {d.frequency_hz.min():.3g}–"
+                    f"{d.frequency_hz.max():.3g} Hz, amplitudes {points['amplitude'].min():.3g}–"
+                    f"{points['amplitude'].max():.3g} {s.amplitude_unit}; gap of the current design: "
+                    f"**{residuals['gap']:.4f}**"
+                    + (f" (drawn as {len(points['frequency_hz'])} bin means; fits bin them too)"
+                       if len(points["frequency_hz"]) < len(curves.in_mode(d, s.design.mode)) else ""))
         if s.measured_loop is not None:
             f, amp, _ = s.measured_loop.harmonic()
             lines.append(f"**Loop**: {s.measured_loop.time_s.size} samples at {f:.3g} Hz, amplitude "
@@ -152,8 +163,18 @@ class MeasuredView(PlotView):
         for a in PARAMETERS:
             corr.append(f"| {LABELS[a][0]} | " + " | ".join(f"{r.correlation[a][b]:+.2f}" for b in PARAMETERS) + " |")
         warnings = "".join(f"\n\n⚠ {w}" for w in r.warnings)
+        by_mode = ("\n\nGap per mode: " + ", ".join(f"{m} **{g:.4f}**" for m, g in r.gap_by_mode.items())
+                   if r.gap_by_mode else "")
+        prediction = ""
+        if r.prediction:
+            p = r.prediction
+            held = f"; the rows left out are predicted with a gap of **{p['gap_held_out']:.4f}**" if "gap_held_out" in p else ""
+            prediction = (f"\n\n**Fitted on {p['fit_on']}** ({p['points_fitted']} points){held}:\n\n"
+                          "| mode | amplitude | points | fitted | gap |\n|---|---|---|---|---|\n"
+                          + "\n".join(f"| {g['mode']} | {g['amplitude']:.3g} | {g['points']} | "
+                                      f"{'yes' if g['fitted'] else 'predicted'} | {g['gap']:.4f} |" for g in p["groups"]))
         return (f"### Fitted ({r.method})\n\nGap (relative RMS misfit of complex stiffness): **{gap}**{loop}; "
-                f"{r.points} points, {r.starts} starts.{warnings}\n\n" + "\n".join(rows)
+                f"{r.points} points, {r.starts} starts.{by_mode}{prediction}{warnings}\n\n" + "\n".join(rows)
                 + "\n\n**Correlation between parameters**\n\n" + "\n".join(corr))
 
     def __panel__(self):
@@ -172,7 +193,7 @@ class MeasuredView(PlotView):
             pn.Row(self.example, self.clear),
             self.message,
             self.summary,
-            pn.Row(self.method, self.sweep),
+            pn.Row(self.method, self.sweep, self.fit_on),
             pn.Row(self.fit_button, self.use),
             self.download,
             self.results,

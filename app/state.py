@@ -8,6 +8,7 @@ draw from the data methods below, which ask the (cached) core; nothing here draw
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -19,11 +20,12 @@ from core.data import (
     DataError,
     MeasuredLoop,
     MeasuredStiffness,
+    combined,
     parse_loop,
     parse_stiffness,
 )
 from core.design import SIZE_RANGE, as_dict
-from core.fit import FitResult, fit_global, fit_two_step
+from core.fit import FitResult, fit_global, fit_two_step, predicted, selection
 
 from . import curves, units
 from .units import FREQUENCY_BOUNDS
@@ -132,6 +134,10 @@ class ExplorerState(param.Parameterized):
     )
     sweep_amplitude = param.Number(default=None, allow_None=True, label="Sweep amplitude",
                                    doc="The amplitude (SI) whose frequency sweep the two-step fit uses.")
+    fit_on = param.String(default="", label="Fit on (the rest is predicted)",
+                          doc="Empty: fit every row. Else mode=NAME[+NAME…] and/or amplitude=VALUE[+VALUE…] "
+                          "(SI), comma-separated, e.g. mode=axial,amplitude=1e-4: the fit uses those rows and "
+                          "predicts the others, with the gap of each mode and amplitude.")
 
     def __init__(self, **params):
         self._loaded = []  # the last design loaded (a file, a fit): kept while the inputs show it
@@ -278,7 +284,28 @@ class ExplorerState(param.Parameterized):
             if len(sweep) < 3:
                 raise ValueError("the sweep at that amplitude has fewer than 3 points")
             return fit_two_step(self.design, self.measured_loop, sweep)
-        return fit_global(self.design, self.measured, self.measured_loop)
+        if not self.fit_on.strip() or self.measured is None:
+            return fit_global(self.design, self.measured, self.measured_loop)
+        spec = self.fit_on.strip()[:500]
+        chosen = selection(self.measured, self.design.mode, spec)
+        result = fit_global(self.design, self.measured.select(chosen), self.measured_loop)
+        return dataclasses.replace(result, prediction=predicted(result, self.measured, chosen, spec))
+
+    def load_measured_files(self, files: dict) -> bool:
+        """Several measured-stiffness files (name → content) as one table: a file without a mode
+        column is in the design's mode. A bad file: its message, and the last data kept."""
+        parts = []
+        for name, content in files.items():
+            data, message = read_measured(parse_stiffness, content, name)
+            if data is None:
+                self.data_message = message
+                return False
+            parts.append(data)
+        if not parts:
+            return False
+        self.data_message = ""
+        self.param.update(measured=combined(parts, self.design.mode), fit_result=None)
+        return True
 
     def try_fit(self) -> FitResult | str:
         """:meth:`compute_fit`, or why it cannot run (pure: safe in a worker thread)."""

@@ -18,12 +18,31 @@ CHUNK_BYTES = 4 * 1024 * 1024  # per websocket message (app.main.UPLOAD_MESSAGE_
 LIMIT = f"{MAX_BYTES // (1024 * 1024)}MB"
 
 
-def csv_dropper() -> pn.widgets.FileDropper:
-    """A drop area for one CSV file of at most :data:`MAX_BYTES`."""
+MAX_FILES = 8
+
+
+def csv_dropper(multiple: bool = False) -> pn.widgets.FileDropper:
+    """A drop area for one CSV file (or up to :data:`MAX_FILES`) of at most :data:`MAX_BYTES` each."""
     return pn.widgets.FileDropper(
         accepted_filetypes=[".csv", "text/csv", "text/plain"], max_file_size=LIMIT, chunk_size=CHUNK_BYTES,
-        multiple=False, previews=[], layout="compact", sizing_mode="stretch_width", height=90,
+        multiple=multiple, max_files=MAX_FILES if multiple else None, previews=[], layout="compact",
+        sizing_mode="stretch_width", height=90,
     )
+
+
+def on_files(dropper: pn.widgets.FileDropper, load: Callable[[dict], object]) -> None:
+    """Call ``load({filename: content, …})`` with every file in the drop area whenever one is
+    added (several files read as one table); removing files leaves the data loaded."""
+    seen: dict[str, bytes | str] = {}
+
+    def changed(event):
+        files = dict(event.new)
+        if any(seen.get(name) is not content for name, content in files.items()):
+            seen.clear()
+            seen.update(files)
+            load(files)
+
+    dropper.param.watch(changed, "value")
 
 
 def on_upload(dropper: pn.widgets.FileDropper, load: Callable[[bytes | str, str], object]) -> None:

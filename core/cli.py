@@ -7,6 +7,7 @@ cannot converge exits with status 1 and one line; no traceback is ever printed.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import re
 import sys
@@ -17,7 +18,7 @@ from contextlib import contextmanager
 import numpy as np
 
 from .bushing import MAX_SLICES, loop, slice_count, stiffness
-from .data import DataError, csv_text
+from .data import MAX_ROWS, DataError, csv_text
 from .design import DesignError, read_design
 from .material import ConvergenceError
 
@@ -151,6 +152,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _measured_arguments(ft, "geometry, mode and starting material")
     ft.add_argument("--loop", metavar="LOOP.csv", help="a measured steady loop (time_s, displacement, force)")
+    ft.add_argument("--fit-on", metavar="SELECTION",
+                    help="fit only these rows, predict the rest (the report's `prediction`): "
+                    "mode=NAME[+NAME…] and/or amplitude=VALUE[+VALUE…], comma-separated, e.g. "
+                    "mode=axial,amplitude=1e-4")
     ft.add_argument("-o", dest="output", metavar="FITTED.json", help="write here, not to stdout")
 
     dg = sub.add_parser(
@@ -191,8 +196,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _measured_arguments(parser: argparse.ArgumentParser, design_help: str) -> None:
-    """MEASURED.csv --design DESIGN.json: what `fit` and `diagnose` both take."""
-    parser.add_argument("measured", metavar="MEASURED.csv", help="measured stiffness (docs/files.md)")
+    """MEASURED.csv … --design DESIGN.json: what `fit` and `diagnose` both take."""
+    parser.add_argument("measured", metavar="MEASURED.csv", nargs="+",
+                        help="measured stiffness (docs/files.md); several files are read as one (a file "
+                        "with a mode column may hold several directions; one without is in the design's mode)")
     parser.add_argument("--design", required=True, metavar="DESIGN.json", help=design_help)
 
 
@@ -291,14 +298,34 @@ def _fail(message: str, status: int):
     raise SystemExit(status)
 
 
+MAX_MEASURED_FILES = 20
+
+
+def _read_measured(paths: list[str], design):
+    """The measured files as one table (rows without a mode in the design's mode)."""
+    from .data import combined, read_stiffness
+
+    if len(paths) > MAX_MEASURED_FILES:
+        raise InputError(f"bushing: at most {MAX_MEASURED_FILES} measured files, got {len(paths)}")
+    data = combined([read_stiffness(p) for p in paths], design.mode)
+    if len(data) > MAX_ROWS:
+        raise InputError(f"bushing: the measured files hold {len(data)} rows together; at most {MAX_ROWS}")
+    return data
+
+
 def _cmd_fit(args) -> None:
-    from .data import read_loop, read_stiffness
-    from .fit import fit_global
+    from .data import read_loop
+    from .fit import fit_global, predicted, selection
 
     design = read_design(args.design)
-    data = read_stiffness(args.measured)
+    data = _read_measured(args.measured, design)
     loop_data = read_loop(args.loop) if args.loop else None
-    result = fit_global(design, data, loop_data)
+    if args.fit_on is None:
+        result = fit_global(design, data, loop_data)
+    else:
+        chosen = selection(data, design.mode, args.fit_on)
+        result = fit_global(design, data.select(chosen), loop_data)
+        result = dataclasses.replace(result, prediction=predicted(result, data, chosen, args.fit_on))
     _write_text(result.to_json(), args.output)
     for line in result.warnings:  # the fit succeeded; what the user must know, one line each
         sys.stderr.write(f"bushing fit: warning: {line}\n")
@@ -329,7 +356,6 @@ class Progress:
 
 
 def _cmd_diagnose(args) -> None:
-    from .data import read_stiffness
     from .diagnose import BRANCHES, diagnose, summary
 
     baseline = [b.strip() for b in args.baseline.split(",") if b.strip()]
@@ -338,7 +364,13 @@ def _cmd_diagnose(args) -> None:
         raise InputError(f"bushing diagnose: --baseline takes branches from {','.join(BRANCHES)}, "
                          f"got {args.baseline!r}")
     design = read_design(args.design)
-    data = read_stiffness(args.measured)
+    data = _read_measured(args.measured, design)
+    if data.mode is not None and len(set(data.mode)) > 1:
+        raise InputError("bushing diagnose: the data hold several modes; the diagnosis works on one direction "
+                         f"at a time (found {', '.join(sorted(set(data.mode)))}): give one mode's rows")
+    if data.mode is not None:
+        design = design.in_mode(data.mode[0])
+        data = dataclasses.replace(data, mode=None)
     result = diagnose(design, data, baseline=baseline, progress=Progress(sys.stderr))
     report = result.to_json()
     if args.predictions:

@@ -18,6 +18,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .design import MODES
+
 MAX_BYTES = 20 * 1024 * 1024
 MAX_ROWS = 200_000
 # fits and the diagnosis work on at most about this many stiffness points (denser data binned)
@@ -79,6 +81,7 @@ class MeasuredStiffness(ComplexStiffness):
     amplitude: np.ndarray
     stiffness: np.ndarray  # complex
     count: np.ndarray | None = None
+    mode: np.ndarray | None = None  # per row (the file's `mode` column); None: the design's mode
 
     def __len__(self):
         return self.frequency_hz.size
@@ -95,7 +98,12 @@ class MeasuredStiffness(ComplexStiffness):
     def select(self, mask) -> MeasuredStiffness:
         mask = np.asarray(mask)
         count = None if self.count is None else self.count[mask]
-        return MeasuredStiffness(self.frequency_hz[mask], self.amplitude[mask], self.stiffness[mask], count)
+        mode = None if self.mode is None else self.mode[mask]
+        return MeasuredStiffness(self.frequency_hz[mask], self.amplitude[mask], self.stiffness[mask], count, mode)
+
+    def modes(self, default: str) -> np.ndarray:
+        """The mode of every row: the file's, or ``default`` (the design's) without a column."""
+        return np.full(len(self), default, dtype=object) if self.mode is None else self.mode
 
     def binned(self, max_points: int = MAX_FIT_POINTS) -> MeasuredStiffness:
         """Dense data reduced to about ``max_points`` entries, each the mean complex stiffness of
@@ -112,6 +120,9 @@ class MeasuredStiffness(ComplexStiffness):
         if not exact:  # scattered amplitudes: bands of equal count
             bands = max(1, int(math.sqrt(max_points)))
             group = (np.argsort(np.argsort(self.amplitude, kind="stable"), kind="stable") * bands) // n
+        if self.mode is not None:  # never a bin across two modes
+            _, mode_index = np.unique(self.mode.astype(str), return_inverse=True)
+            group = group + (int(group.max()) + 1) * mode_index
         groups, sizes = np.unique(group, return_counts=True)
         share = max_points * sizes / n  # each group's bins: largest remainders, at least one
         shares = np.maximum(np.floor(share).astype(np.int64), 1)
@@ -137,7 +148,11 @@ class MeasuredStiffness(ComplexStiffness):
             amplitude[label] = self.amplitude
         else:
             amplitude = np.exp(mean(np.log(self.amplitude)))
-        return MeasuredStiffness(np.exp(mean(np.log(self.frequency_hz))), amplitude, stiffness, count)
+        mode = None
+        if self.mode is not None:
+            mode = np.empty(count.size, dtype=object)
+            mode[label] = self.mode
+        return MeasuredStiffness(np.exp(mean(np.log(self.frequency_hz))), amplitude, stiffness, count, mode)
 
     def amplitudes(self) -> np.ndarray:
         """The distinct amplitudes, the most frequent first (ties in increasing order)."""
@@ -145,7 +160,8 @@ class MeasuredStiffness(ComplexStiffness):
         return values[np.argsort(-counts, kind="stable")]
 
     def to_csv(self, path: str | Path | None = None, polar: bool = True) -> str:
-        cols = {"frequency_hz": self.frequency_hz, "amplitude": self.amplitude}
+        cols = {} if self.mode is None else {"mode": list(self.mode)}
+        cols.update({"frequency_hz": self.frequency_hz, "amplitude": self.amplitude})
         if polar:
             cols.update(magnitude=self.magnitude, loss_factor=self.loss_factor)
         else:
@@ -332,10 +348,16 @@ def parse_stiffness(text: str | bytes) -> MeasuredStiffness:
             f"line 1: the header must name frequency_hz, amplitude and either {need.replace(' and ', ' or ')}"
             f" (found: {', '.join(df.columns)})"
         )
-    extra = cols - set(STIFFNESS_KEYS) - set(pair)
+    extra = cols - set(STIFFNESS_KEYS) - set(pair) - {"mode"}
     if extra:
         raise DataError(f"line 1: unknown column(s) {', '.join(sorted(extra))}")
     _rows(df, "stiffness")
+    mode = None
+    if "mode" in cols:
+        mode = np.array([str(m).strip() for m in df["mode"].tolist()], dtype=object)
+        bad = [i for i, m in enumerate(mode) if m not in MODES]
+        if bad:
+            raise DataError(f"line {bad[0] + 2}: mode must be one of {', '.join(MODES)}, got {mode[bad[0]]!r}")
     v = _numbers(df, (*STIFFNESS_KEYS, *pair), "stiffness")
     _positive(v, "frequency_hz")
     _positive(v, "amplitude")
@@ -357,7 +379,19 @@ def parse_stiffness(text: str | bytes) -> MeasuredStiffness:
     if active.size:  # a passive specimen dissipates: Im K ≥ 0
         raise DataError(f"line {active[0] + 2}: a negative loss factor (Im K < 0) would mean the bushing gives "
                         "energy back each cycle; a rubber bushing cannot")
-    return MeasuredStiffness(v["frequency_hz"], v["amplitude"], k)
+    return MeasuredStiffness(v["frequency_hz"], v["amplitude"], k, None, mode)
+
+
+def combined(parts: list[MeasuredStiffness], default_mode: str) -> MeasuredStiffness:
+    """Several measured files as one: rows of a file without a `mode` column are in
+    ``default_mode`` (the design's) when another file names its modes."""
+    if len(parts) == 1:
+        return parts[0]
+    mode = None
+    if any(p.mode is not None for p in parts):
+        mode = np.concatenate([p.modes(default_mode) for p in parts])
+    return MeasuredStiffness(*(np.concatenate([getattr(p, k) for p in parts])
+                               for k in ("frequency_hz", "amplitude", "stiffness")), None, mode)
 
 
 def parse_loop(text: str | bytes) -> MeasuredLoop:

@@ -166,6 +166,12 @@ class Design:
             raise DesignError("name", f"must be a string, got {self.name!r}")
         object.__setattr__(self, "effects", _frozen_effects(self.effects))
 
+    def in_mode(self, mode: str) -> Design:
+        """This bushing and material in another direction: the same ``shape`` where the mode
+        allows it (conical has no long form: its default then)."""
+        shape = None if (mode == "conical" and self.shape == "long") else self.shape
+        return self if (mode, shape) == (self.mode, self.shape) else self.replace(mode=mode, shape=shape)
+
     @property
     def shape_kind(self) -> str:
         """The shape factor used: ``shape``, or the mode's default."""

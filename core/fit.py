@@ -86,6 +86,37 @@ def with_values(design: Design, values: dict[str, float]) -> Design:
     return design.replace(**changes)
 
 
+def model_stiffness(design: Design, data: MeasuredStiffness) -> np.ndarray:
+    """The design's complex K at every row of ``data``, each row in its own mode (a file's
+    `mode` column) or the design's."""
+    if data.mode is None:
+        return stiffness_points(design, data.frequency_hz, data.amplitude)
+    k = np.empty(len(data), dtype=complex)
+    for mode in np.unique(data.mode.astype(str)):
+        rows = data.mode == mode
+        k[rows] = stiffness_points(design.in_mode(mode), data.frequency_hz[rows], data.amplitude[rows])
+    return k
+
+
+def check_data_amplitudes(design: Design, data: MeasuredStiffness) -> None:
+    """Every row's amplitude within what a test can drive and resolve, in its own mode."""
+    if data.mode is None:
+        check_measured_amplitude(design, data.amplitude)
+        return
+    for mode in np.unique(data.mode.astype(str)):
+        check_measured_amplitude(design.in_mode(mode), data.amplitude[data.mode == mode], f"{mode} amplitude")
+
+
+def gaps_by_mode(design: Design, data: MeasuredStiffness) -> dict[str, float]:
+    """The gap of each mode's rows (empty without a `mode` column)."""
+    if data.mode is None:
+        return {}
+    k = model_stiffness(design, data)
+    return {m: gap(k[data.mode == m], data.stiffness[data.mode == m],
+                   None if data.count is None else data.count[data.mode == m])
+            for m in np.unique(data.mode.astype(str))}
+
+
 def folded(phase: np.ndarray, values: np.ndarray, bins: int):
     """A steady periodic record folded onto one period: the mean phase (in [0, 2π)) and value in
     each of ``bins`` equal phase bins that holds samples, and their counts; the record itself
@@ -129,6 +160,8 @@ class FitResult:
     # bound within the fitting range (empty if the fit was not profiled)
     intervals: dict[str, tuple[float | None, float | None]] = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
+    gap_by_mode: dict[str, float] = field(default_factory=dict)  # with data of several modes
+    prediction: dict = field(default_factory=dict)  # cross-mode prediction (fit on a subset)
 
     @property
     def undetermined(self) -> list[str]:
@@ -155,6 +188,10 @@ class FitResult:
             out["confidence"] = CONFIDENCE
             out["intervals"] = {k: [finite(lo), finite(hi)] for k, (lo, hi) in self.intervals.items()}
             out["undetermined"] = self.undetermined
+        if self.gap_by_mode:
+            out["gap_by_mode"] = {k: finite(v) for k, v in self.gap_by_mode.items()}
+        if self.prediction:
+            out["prediction"] = self.prediction
         if self.warnings:
             out["warnings"] = list(self.warnings)
         if self.loop_rms is not None:
@@ -208,7 +245,7 @@ class _Problem:
         design = self.model(theta)
         parts = []
         if self.data is not None:
-            k = stiffness_points(design, self.data.frequency_hz, self.data.amplitude)
+            k = model_stiffness(design, self.data)
             r = relative_residual(k, self.data.stiffness) * self.data.weight
             parts += [r.real, r.imag]
         if self.loop is not None:
@@ -343,14 +380,15 @@ def _result(problem: _Problem, sol, method: str, starts: int, design: Design, in
     g = float("nan")
     data, loop = problem.full_data, problem.full_loop  # every measured point, binned or not
     if data is not None:
-        g = gap(stiffness_points(fitted, data.frequency_hz, data.amplitude), data.stiffness, data.count)
+        g = gap(model_stiffness(fitted, data), data.stiffness, data.count)
     loop_rms = None
     if loop is not None:
         f = sum(loop_force(fitted, problem.loop_f, problem.loop_amp, loop.harmonic()[2]))
         loop_rms = float(np.sqrt(np.mean((f - (loop.force - np.mean(loop.force))) ** 2)) / problem.loop_scale)
     n = 0 if data is None else data.measured_points
+    by_mode = {} if data is None else gaps_by_mode(fitted, data)
     return FitResult(fitted, errors, corr, g, float(sol.cost), n, method, starts, loop_rms,
-                     intervals=intervals or {}, warnings=tuple(warnings))
+                     intervals=intervals or {}, warnings=tuple(warnings), gap_by_mode=by_mode)
 
 
 def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: MeasuredLoop | None = None,
@@ -370,7 +408,7 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     if data is None and loop is None:
         raise ValueError("give measured stiffness, a measured loop, or both")
     if data is not None:
-        check_measured_amplitude(design, data.amplitude)  # the measured amplitudes, for this bushing
+        check_data_amplitudes(design, data)  # the measured amplitudes, for this bushing
     if loop is not None:
         check_measured_amplitude(design, loop.harmonic()[1], "the loop's amplitude")
     n = (0 if data is None else 2 * len(data)) + (0 if loop is None else loop.force.size)
@@ -386,6 +424,49 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
         return _result(problem, sol, "global", len(points), design)
     sol, found, complete = _profiled(problem, sol)
     return _result(problem, sol, "global", len(points), design, found, _warnings(problem, sol, found, complete))
+
+
+def selection(data: MeasuredStiffness, design_mode: str, spec: str) -> np.ndarray:
+    """The rows that ``spec`` chooses: ``key=value[+value…]`` items joined by commas, keys
+    ``mode`` (mode names) and ``amplitude`` (m or rad, matched to 1e-6 relative), e.g.
+    ``mode=axial,amplitude=1e-4``. Raises ValueError on a bad spec or an empty choice."""
+    chosen = np.ones(len(data), dtype=bool)
+    modes = data.modes(design_mode)
+    for item in filter(None, (part.strip() for part in spec.split(","))):
+        key, sep, value = item.partition("=")
+        values = [v.strip() for v in value.split("+") if v.strip()]
+        if not sep or not values or key.strip() not in ("mode", "amplitude"):
+            raise ValueError(f"--fit-on: {item!r}: give mode=NAME[+NAME…] or amplitude=VALUE[+VALUE…]")
+        if key.strip() == "mode":
+            chosen &= np.isin(modes.astype(str), values)
+        else:
+            try:
+                amps = [float(v) for v in values]
+            except ValueError:
+                raise ValueError(f"--fit-on: {item!r}: amplitudes are numbers in m or rad") from None
+            chosen &= np.any([np.isclose(data.amplitude, a, rtol=1e-6, atol=0) for a in amps], axis=0)
+    if not chosen.any():
+        raise ValueError(f"--fit-on {spec!r} chooses none of the {len(data)} rows")
+    return chosen
+
+
+def predicted(result: FitResult, data: MeasuredStiffness, fitted_on: np.ndarray, spec: str) -> dict:
+    """The sequel's protocol: the fit of ``fitted_on`` rows predicting every (mode, amplitude)
+    group of ``data``; each group's gap, whether it was fitted, and the gap of all held-out rows."""
+    design = result.design
+    k = model_stiffness(design, data)
+    modes = data.modes(design.mode).astype(str)
+    groups = []
+    for mode in np.unique(modes):
+        for amp in np.unique(data.amplitude[modes == mode]):
+            rows = (modes == mode) & (data.amplitude == amp)
+            groups.append({"mode": mode, "amplitude": float(amp), "points": int(rows.sum()),
+                           "fitted": bool(fitted_on[rows].all()), "gap": gap(k[rows], data.stiffness[rows])})
+    held = ~fitted_on
+    out = {"fit_on": spec, "points_fitted": int(fitted_on.sum()), "groups": groups}
+    if held.any():
+        out["gap_held_out"] = gap(k[held], data.stiffness[held])
+    return out
 
 
 def fit_two_step(design: Design, loop: MeasuredLoop, sweep: MeasuredStiffness,
