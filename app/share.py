@@ -5,12 +5,23 @@ from __future__ import annotations
 
 import io
 
+import numpy as np
 import panel as pn
 
 from core.data import csv_text
 from core.design import dumps_design
+from core.export import export
 
 from .state import ExplorerState
+from .units import to_si_amplitude
+
+# label → (export format, file name)
+TOOL_FORMATS = {
+    "Nastran bulk data (PBUSH)": ("nastran", "bushing.bdf"),
+    "Adams bushing file (.bus)": ("adams", "bushing.bus"),
+    "Neutral table, every direction (CSV)": ("table", "bushing-directions.csv"),
+    "Neutral table, every direction (JSON)": ("table-json", "bushing-directions.json"),
+}
 
 
 class ExportView(pn.viewable.Viewer):
@@ -27,6 +38,16 @@ class ExportView(pn.viewable.Viewer):
             callback=self._table_csv, filename="bushing-stiffness.csv", label="Stiffness table (CSV)",
             color="default", sizing_mode="stretch_width",
         )
+        self.tool_format = pn.widgets.Select(
+            name="For multibody and FE tools", options=list(TOOL_FORMATS), value="Nastran bulk data (PBUSH)",
+            description="Every direction: over the sweep's frequency range (30 frequencies) at the operating "
+            "amplitude and the Fletcher–Gent amplitudes; Adams: linearised at the operating point (docs/export.md).",
+            sizing_mode="stretch_width")
+        self.tool_file = pn.widgets.FileDownload(
+            callback=self._tool_file, filename=TOOL_FORMATS[self.tool_format.value][1], label="Download",
+            color="default", sizing_mode="stretch_width",
+        )
+        self.tool_format.param.watch(lambda e: setattr(self.tool_file, "filename", TOOL_FORMATS[e.new][1]), "value")
 
     def _design_json(self):
         return io.StringIO(dumps_design(self.state.design))
@@ -34,10 +55,26 @@ class ExportView(pn.viewable.Viewer):
     def _table_csv(self):
         return io.StringIO(csv_text(self.state.stiffness_table()))
 
+    def tool_text(self, label: str) -> str:
+        """The export ``label`` (:data:`TOOL_FORMATS`) of the current design."""
+        s = self.state
+        fmt, _ = TOOL_FORMATS[label]
+        x = float(to_si_amplitude(s.amplitude, s.design.mode))
+        if fmt == "adams":
+            return export(s.design, "adams", [s.frequency_hz], [x])
+        freqs = np.geomspace(s.freq_min, s.freq_max, 30)
+        amps = [x, *(float(to_si_amplitude(a, s.design.mode)) for a in s.fletcher_gent_amplitudes(s.design))]
+        return export(s.design, "table" if fmt.startswith("table") else fmt, freqs, amps, as_json=fmt == "table-json")
+
+    def _tool_file(self):
+        return io.StringIO(self.tool_text(self.tool_format.value))
+
     def __panel__(self):
         return pn.Column(
             self.design_file,
             self.table_file,
+            self.tool_format,
+            self.tool_file,
             pn.pane.Markdown(
                 "PNG: the save icon in each plot's toolbar. Share: the address bar holds the whole "
                 "design; copy it.", sizing_mode="stretch_width", styles={"font-size": "0.9em"}),

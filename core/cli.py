@@ -192,6 +192,23 @@ def build_parser() -> argparse.ArgumentParser:
                     help="peak angle of the torsion and conical directions, rad")
     cd.add_argument("-o", dest="output", metavar="CARD.csv", help="write here, not to stdout")
 
+    ex = sub.add_parser(
+        "export",
+        help="files for multibody and FE tools: neutral tables, Nastran PBUSH/PBUSHT/TABLED1, Adams .bus",
+        description="The design's stiffness in every direction over a frequency × amplitude grid, as a neutral "
+        "table (CSV, or JSON when OUT ends in .json), Nastran bulk data or an Adams TeimOrbit bushing file "
+        "(linearised at the first amplitude and frequency). Amplitudes are in the design's mode (m or rad); "
+        "every direction is taken at the same equivalent strains (docs/export.md).",
+    )
+    ex.add_argument("design", metavar="DESIGN.json", help="design file (docs/files.md)")
+    ex.add_argument("--format", required=True, choices=("table", "nastran", "adams"), help="the file to write")
+    ex.add_argument("--freq", nargs=3, required=True, metavar=("F1", "F2", "N"),
+                    help="N frequencies from F1 to F2 in Hz (linear unless --log)")
+    ex.add_argument("--log", action="store_true", help="space the frequencies logarithmically")
+    ex.add_argument("--amp", nargs="+", required=True, type=_positive("--amp"), metavar="A",
+                    help="amplitudes in the design's mode, m or rad")
+    ex.add_argument("-o", dest="output", metavar="OUT", help="write here, not to stdout")
+
     return parser
 
 
@@ -389,8 +406,20 @@ def _cmd_card(args) -> None:
     _write_csv({"mode": [r["mode"] for r in rows], **numbers}, args.output)
 
 
+def _cmd_export(args) -> None:
+    from .export import export
+
+    try:
+        freqs = _frequencies(args)
+    except argparse.ArgumentTypeError as exc:
+        raise InputError(f"bushing export: {exc}")
+    design = read_design(args.design)
+    as_json = args.format == "table" and bool(args.output) and args.output.lower().endswith(".json")
+    _write_text(export(design, args.format, freqs, args.amp, as_json=as_json), args.output)
+
+
 COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop, "fit": _cmd_fit, "diagnose": _cmd_diagnose,
-            "card": _cmd_card}
+            "card": _cmd_card, "export": _cmd_export}
 
 
 def main(argv: list[str] | None = None, parser: argparse.ArgumentParser | None = None,

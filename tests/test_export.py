@@ -1,0 +1,193 @@
+"""Exports (docs/export.md): each file is written, read back by a parser written here from the
+formats' documentation (not by the writer's code), and compared with the core's stiffness."""
+
+import io
+import json
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from app.cli import main
+from core import PAPER_B, force_history, write_design
+from core.bushing import stiffness_points, strain_factor
+from core.card import CARD_MODES, card_design
+from core.export import direction_grid, export
+
+FREQS = np.linspace(1.0, 100.0, 5)
+AMPS = [1e-5, 1e-4]
+DOCS = Path(__file__).resolve().parents[1] / "docs" / "export.md"
+
+
+def expected(mode, amp_design_mode, f, design=PAPER_B):
+    """The core's K of ``mode`` at the equivalent strain of ``amp_design_mode`` in the design's mode."""
+    own = card_design(design, design.mode)
+    eps = strain_factor(own.geometry, own.mode, own.shape) * amp_design_mode
+    d = card_design(design, mode)
+    amp = eps / strain_factor(d.geometry, mode, d.shape)
+    return amp, complex(stiffness_points(d, f, amp))
+
+
+def test_neutral_csv_table():
+    table = pd.read_csv(io.StringIO(export(PAPER_B, "table", FREQS, AMPS)))
+    assert len(table) == 4 * len(AMPS) * len(FREQS)
+    assert set(table.loc[table["mode"] == "axial", "amplitude"]) == set(AMPS)  # the design's own mode: as given
+    for _, row in table.sample(12, random_state=0).iterrows():
+        i = int(np.argmin(np.abs(np.log(table.loc[(table["mode"] == row["mode"]), "amplitude"].unique() / row["amplitude"]))))
+        amp, k = expected(row["mode"], AMPS[i], row["frequency_hz"])
+        assert row["amplitude"] == pytest.approx(amp, rel=1e-10)
+        assert row["stiffness_real"] == pytest.approx(k.real, rel=1e-10)
+        assert row["loss_factor"] == pytest.approx(k.imag / k.real, rel=1e-10)
+        assert row["stiffness_unit"] == ("N/m" if row["mode"] in ("axial", "radial") else "N·m/rad")
+
+
+def test_neutral_json_table():
+    data = json.loads(export(PAPER_B, "table", FREQS, AMPS, as_json=True))
+    assert data["frequency_hz"] == FREQS.tolist() and data["header"]["design"]["mode"] == "axial"
+    for mode in CARD_MODES:
+        d = data["directions"][mode]
+        for i, a in enumerate(AMPS):
+            for j, f in enumerate(FREQS):
+                amp, k = expected(mode, a, f)
+                assert d["amplitude"][i] == pytest.approx(amp, rel=1e-12)
+                assert d["magnitude"][i][j] == pytest.approx(abs(k), rel=1e-12)
+
+
+def nastran_cards(text):
+    """Small-field fixed format: 8-character fields, field 1 the name (blank: continuation)."""
+    cards = []
+    for line in text.splitlines():
+        if line.startswith("$") or not line.strip():
+            continue
+        fields = [line[i:i + 8].strip() for i in range(8, len(line), 8)]
+        if line[:8].strip():
+            cards.append([line[:8].strip(), *fields])
+        else:
+            cards[-1].extend(fields)
+    return cards
+
+
+def nastran_float(text):
+    """Nastran reals: 1.5, 1.5E+6, and the short exponent 1.5+6 or 1.5-6."""
+    m = re.fullmatch(r"([+-]?\d*\.\d*)([+-]\d+)", text)
+    return float(f"{m.group(1)}e{m.group(2)}") if m else float(text)
+
+
+def test_nastran_pbush_pbusht_tabled1():
+    cards = nastran_cards(export(PAPER_B, "nastran", FREQS, AMPS))
+    pbush = [c for c in cards if c[0] == "PBUSH"]
+    pbusht = {int(c[1]): c for c in cards if c[0] == "PBUSHT"}
+    tables = {int(c[1]): c for c in cards if c[0] == "TABLED1"}
+    assert [int(c[1]) for c in pbush] == [1, 2]
+    order = ("axial", "radial", "radial", "torsion", "conical", "conical")
+    for card in pbush:
+        pid = int(card[1])
+        assert card[2] == "K" and card[9] == "" and card[10] == "GE"
+        k_values = [nastran_float(v) for v in card[3:9]]
+        ge_values = [nastran_float(v) for v in card[11:17]]
+        t = pbusht[pid]
+        assert t[2] == "K" and t[10] == "GE"
+        for d, mode in enumerate(order):
+            _, k0 = expected(mode, AMPS[pid - 1], FREQS[0])
+            assert k_values[d] == pytest.approx(k0.real, rel=2e-5)
+            assert ge_values[d] == pytest.approx(k0.imag / k0.real, rel=2e-5)
+            for tid, part in ((int(t[3 + d]), "k"), (int(t[11 + d]), "ge")):
+                table = tables[tid]
+                assert table[2:4] == ["LINEAR", "LINEAR"]
+                values = [v for v in table[4:] if v]
+                assert values[-1] == "ENDT"
+                xy = np.array([nastran_float(v) for v in values[:-1]]).reshape(-1, 2)
+                np.testing.assert_allclose(xy[:, 0], FREQS, rtol=1e-6)
+                for f, y in xy:
+                    _, k = expected(mode, AMPS[pid - 1], f)
+                    assert y == pytest.approx(k.real if part == "k" else k.imag / k.real, rel=2e-5)
+
+
+def adams_sections(text):
+    """TeimOrbit: [SECTION] headers, KEY = value lines, {column names} then rows of numbers."""
+    sections, current = {}, None
+    for line in text.splitlines():
+        line = line.strip()
+        if not line or line.startswith("$"):
+            continue
+        if line.startswith("[") and line.endswith("]"):
+            current = sections.setdefault(line[1:-1], {"keys": {}, "rows": []})
+        elif "=" in line and current is not None:
+            key, value = (s.strip() for s in line.split("=", 1))
+            current["keys"][key] = value.strip("'")
+        elif line.startswith(("{", "(", "'")):
+            continue
+        elif current is not None:
+            current["rows"].append([float(v) for v in line.split()])
+    return sections
+
+
+def test_adams_bus_file():
+    sections = adams_sections(export(PAPER_B, "adams", [10.0], [1e-4]))
+    assert sections["MDI_HEADER"]["keys"]["FILE_TYPE"] == "bus"
+    assert sections["UNITS"]["keys"] == {"LENGTH": "meter", "ANGLE": "radians", "FORCE": "newton", "MASS": "kg",
+                                         "TIME": "second"}
+    for mode, curve, damping in (("axial", "Z_FORCE_CURVE", "Z_DAMPING"), ("radial", "Y_FORCE_CURVE", "Y_DAMPING"),
+                                 ("torsion", "Z_TORQUE_CURVE", "RZ_DAMPING"),
+                                 ("conical", "X_TORQUE_CURVE", "RX_DAMPING")):
+        amp, k = expected(mode, 1e-4, 10.0)
+        rows = np.array(sections[curve]["rows"])
+        assert rows[:, 0].min() == pytest.approx(-amp) and rows[:, 0].max() == pytest.approx(amp)
+        slope = np.polyfit(rows[:, 0], rows[:, 1], 1)[0]
+        assert slope == pytest.approx(k.real, rel=1e-8)
+        assert float(sections[damping]["keys"]["DAMPING"]) == pytest.approx(k.imag / (2 * math.pi * 10.0), rel=1e-8)
+
+
+def test_the_co_simulation_loop_of_the_docs_gives_the_force_history():
+    code = re.search(r"```python\n(.*?)```", DOCS.read_text(), re.DOTALL).group(1)
+    code = code.replace("range(2000)", "range(300)")  # the same loop, shorter
+    scope = {}
+    exec(code, scope)  # noqa: S102 - the documentation's own example
+    whole = force_history(PAPER_B, np.array(scope["record"]), 1e-3).force
+    np.testing.assert_allclose(scope["forces"], whole, rtol=1e-9, atol=1e-9 * np.max(np.abs(whole)))
+
+
+def test_the_command_line_export_and_its_limits(tmp_path, capsys):
+    write_design(PAPER_B, tmp_path / "d.json")
+    assert main(["export", str(tmp_path / "d.json"), "--format", "table", "--freq", "1", "100", "3", "--amp",
+                 "1e-4", "-o", str(tmp_path / "t.json")]) == 0
+    assert json.loads((tmp_path / "t.json").read_text())["directions"]["radial"]["amplitude_unit"] == "m"
+    assert main(["export", str(tmp_path / "d.json"), "--format", "nastran", "--freq", "1", "100", "3", "--amp",
+                 "1e-4"]) == 0
+    assert capsys.readouterr().out.count("PBUSH ") == 1
+    for argv, needle in ((["--format", "abaqus", "--freq", "1", "10", "2", "--amp", "1e-4"], "--format"),
+                         (["--format", "table", "--freq", "1", "10", "100000", "--amp", "1e-4", "2e-4"], "at most")):
+        with pytest.raises(SystemExit) as refused:
+            main(["export", str(tmp_path / "d.json"), *argv])
+        assert refused.value.code == 2 and needle in capsys.readouterr().err
+
+
+def test_grid_amplitudes_follow_the_equivalent_strain():
+    grid = direction_grid(PAPER_B.replace(mode="torsion"), FREQS, [0.01])
+    assert grid["torsion"]["amplitude"][0] == pytest.approx(0.01)
+    c = {m: strain_factor(card_design(PAPER_B, m).geometry, m, card_design(PAPER_B, m).shape) for m in CARD_MODES}
+    for m in CARD_MODES:
+        assert c[m] * grid[m]["amplitude"][0] == pytest.approx(grid["strain"][0], rel=1e-12)
+
+
+def test_the_explorers_export_panel_writes_every_tool_format():
+    from app.main import App
+    from app.share import TOOL_FORMATS
+
+    app = App()
+    app.state.amplitude = 0.2  # mm
+    texts = {label: app.export.tool_text(label) for label in TOOL_FORMATS}
+    cards = nastran_cards(texts["Nastran bulk data (PBUSH)"])
+    assert len([c for c in cards if c[0] == "PBUSH"]) == 6  # the operating amplitude and five more
+    adams_file = adams_sections(texts["Adams bushing file (.bus)"])
+    _, k = expected("axial", 0.2e-3, app.state.frequency_hz, app.state.design)
+    slope = np.polyfit(*np.array(adams_file["Z_FORCE_CURVE"]["rows"]).T, 1)[0]
+    assert slope == pytest.approx(k.real, rel=1e-8)
+    table = pd.read_csv(io.StringIO(texts["Neutral table, every direction (CSV)"]))
+    assert table["frequency_hz"].nunique() == 30 and set(table["mode"]) == set(CARD_MODES)
+    assert json.loads(texts["Neutral table, every direction (JSON)"])["header"]["design"] == app.state.design.to_dict()
+    app.export.tool_format.value = "Adams bushing file (.bus)"
+    assert app.export.tool_file.filename == "bushing.bus"
