@@ -293,19 +293,21 @@ class ExplorerState(param.Parameterized):
 
     def load_measured_files(self, files: dict) -> bool:
         """Several measured-stiffness files (name → content) as one table: a file without a mode
-        column is in the design's mode. A bad file: its message, and the last data kept."""
-        parts = []
+        column is in the design's mode. A bad file is left out with its message; the others
+        load. None good: the last data kept."""
+        parts, refused = [], []
         for name, content in files.items():
             data, message = read_measured(parse_stiffness, content, name)
             if data is None:
-                self.data_message = message
-                return False
-            parts.append(data)
+                refused.append(message)
+            else:
+                parts.append(data)
+        note = "; ".join(refused) + (" (not loaded; the other files are)" if refused and parts else "")
         if not parts:
+            self.data_message = note
             return False
-        self.data_message = ""
-        self.param.update(measured=combined(parts, self.design.mode), fit_result=None)
-        return True
+        self.param.update(measured=combined(parts, self.design.mode), fit_result=None, data_message=note)
+        return not refused
 
     def try_fit(self) -> FitResult | str:
         """:meth:`compute_fit`, or why it cannot run (pure: safe in a worker thread)."""

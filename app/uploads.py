@@ -31,16 +31,20 @@ def csv_dropper(multiple: bool = False) -> pn.widgets.FileDropper:
 
 
 def on_files(dropper: pn.widgets.FileDropper, load: Callable[[dict], object]) -> None:
-    """Call ``load({filename: content, …})`` with every file in the drop area whenever one is
-    added (several files read as one table); removing files leaves the data loaded."""
+    """Call ``load({filename: content, …})`` with every file in the drop area whenever the files
+    change (one added, one removed: several files read as one table); an emptied area leaves the
+    data loaded."""
     seen: dict[str, bytes | str] = {}
 
     def changed(event):
         files = dict(event.new)
-        if any(seen.get(name) is not content for name, content in files.items()):
+        same = files.keys() == seen.keys() and all(seen[n] is c for n, c in files.items())
+        if files and not same:
             seen.clear()
             seen.update(files)
             load(files)
+        elif not files:
+            seen.clear()
 
     dropper.param.watch(changed, "value")
 

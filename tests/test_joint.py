@@ -126,3 +126,16 @@ def test_the_explorer_reads_several_files_and_predicts_the_other_modes():
     s.fit_on = "mode=shear"
     s.run_fit()
     assert "chooses none" in s.data_message
+
+
+def test_a_bad_file_among_several_is_left_out_with_its_message():
+    from app.state import ExplorerState
+
+    s = ExplorerState()
+    good = multi_mode(modes=("axial",), per_amplitude=5, seed=50).to_csv()
+    bad = "frequency_hz,amplitude,magnitude,loss_factor\n10,1e-4,,0.1\n"
+    assert not s.load_measured_files({"good.csv": good, "bad.csv": bad})
+    assert len(s.measured) == 15 and s.data_message.startswith("bad.csv: line 2")
+    assert "not loaded; the other files are" in s.data_message
+    assert s.load_measured_files({"good.csv": good}) and s.data_message == ""
+    assert not s.load_measured_files({"bad.csv": bad}) and len(s.measured) == 15  # none good: the last data kept

@@ -240,9 +240,14 @@ def test_upload_fit_and_use(page, explorer_url, tmp_path):
     inputs.first.set_input_files(str(bad))
     page.locator(".data-error").wait_for(timeout=10000)
     assert "line 2: magnitude is missing" in page.locator(".data-error").inner_text()
-    inputs.first.set_input_files(str(good))
-    page.locator(".data-error").wait_for(state="detached", timeout=10000)
+    inputs.first.set_input_files(str(good))  # the drop area holds both: the good one loads
     page.get_by_text("150 points").first.wait_for(timeout=10000)
+    assert "bad.csv: line 2" in page.locator(".data-error").inner_text()
+    assert "not loaded; the other files are" in page.locator(".data-error").inner_text()
+    # removing the bad file from the drop area clears its message
+    item = page.locator(".filepond--item").filter(has_text="bad.csv")
+    item.locator(".filepond--action-revert-item-processing").click()  # "tap to undo" once uploaded
+    page.locator(".data-error").wait_for(state="detached", timeout=10000)
     page.get_by_role("button", name="Fit the five material parameters").click()
     page.get_by_text("Correlation between parameters").wait_for(timeout=20000)
     page.get_by_role("button", name="Use the fitted design in the explorer").click()
