@@ -89,23 +89,7 @@ def build_parser() -> argparse.ArgumentParser:
         "amplitude, stiffness_real, stiffness_imag, magnitude, loss_factor (one row per "
         "amplitude and frequency; N/m axially, N·m/rad in torsion).",
     )
-    st.add_argument("design", metavar="DESIGN.json", help="design file (docs/files.md)")
-    st.add_argument(
-        "--freq",
-        nargs=3,
-        required=True,
-        metavar=("F1", "F2", "N"),
-        help="N frequencies from F1 to F2 in Hz (linear unless --log)",
-    )
-    st.add_argument("--log", action="store_true", help="space the frequencies logarithmically")
-    st.add_argument(
-        "--amp",
-        nargs="+",
-        required=True,
-        type=_positive("--amp"),
-        metavar="A",
-        help="peak amplitudes: displacement in m (axial) or angle in rad (torsion)",
-    )
+    _grid_arguments(st, "peak amplitudes: displacement in m (axial, radial) or angle in rad (torsion, conical)")
     group = st.add_mutually_exclusive_group()
     group.add_argument(
         "--slices",
@@ -200,16 +184,20 @@ def build_parser() -> argparse.ArgumentParser:
         "(linearised at the first amplitude and frequency). Amplitudes are in the design's mode (m or rad); "
         "every direction is taken at the same equivalent strains (docs/export.md).",
     )
-    ex.add_argument("design", metavar="DESIGN.json", help="design file (docs/files.md)")
+    _grid_arguments(ex, "amplitudes in the design's mode, m or rad")
     ex.add_argument("--format", required=True, choices=("table", "nastran", "adams"), help="the file to write")
-    ex.add_argument("--freq", nargs=3, required=True, metavar=("F1", "F2", "N"),
-                    help="N frequencies from F1 to F2 in Hz (linear unless --log)")
-    ex.add_argument("--log", action="store_true", help="space the frequencies logarithmically")
-    ex.add_argument("--amp", nargs="+", required=True, type=_positive("--amp"), metavar="A",
-                    help="amplitudes in the design's mode, m or rad")
     ex.add_argument("-o", dest="output", metavar="OUT", help="write here, not to stdout")
 
     return parser
+
+
+def _grid_arguments(parser: argparse.ArgumentParser, amp_help: str) -> None:
+    """DESIGN.json --freq F1 F2 N [--log] --amp A1 [A2 …]: what `stiffness` and `export` take."""
+    parser.add_argument("design", metavar="DESIGN.json", help="design file (docs/files.md)")
+    parser.add_argument("--freq", nargs=3, required=True, metavar=("F1", "F2", "N"),
+                        help="N frequencies from F1 to F2 in Hz (linear unless --log)")
+    parser.add_argument("--log", action="store_true", help="space the frequencies logarithmically")
+    parser.add_argument("--amp", nargs="+", required=True, type=_positive("--amp"), metavar="A", help=amp_help)
 
 
 def _measured_arguments(parser: argparse.ArgumentParser, design_help: str) -> None:
