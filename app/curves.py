@@ -335,3 +335,21 @@ def card_sweeps(design: Design, frequency_hz: float, strains=None) -> dict:
         out[mode] = {"amplitude": units.display_amplitude(eps / c, mode),
                      "magnitude": units.display_stiffness(np.abs(k), mode), "loss_factor": loss_factor(k)}
     return out
+
+
+def prediction_misfit(fit, measured: MeasuredStiffness | None) -> dict | None:
+    """A fit on a subset (its ``prediction``) against every measured row: per mode, the |K|
+    misfit (model − measured, %) against frequency of the fitted rows and of the predicted ones."""
+    from core.fit import model_stiffness, selection
+
+    if fit is None or not fit.prediction or measured is None:
+        return None
+    chosen = selection(measured, fit.design.mode, fit.prediction["fit_on"])
+    pct = magnitude_residual_pct(model_stiffness(fit.design, measured), measured.stiffness)
+    modes = measured.modes(fit.design.mode).astype(str)
+    out = {}
+    for mode in np.unique(modes):
+        rows = modes == mode
+        out[mode] = {which: {"frequency_hz": measured.frequency_hz[rows & sel], "misfit_pct": pct[rows & sel]}
+                     for which, sel in (("fitted", chosen), ("predicted", ~chosen))}
+    return out

@@ -68,6 +68,7 @@ class MeasuredView(PlotView):
         self.message = pn.pane.HTML("", sizing_mode="stretch_width")
         self.summary = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.results = pn.pane.Markdown("", sizing_mode="stretch_width")
+        self.prediction = pn.pane.HoloViews(None, sizing_mode="stretch_width", visible=False, linked_axes=False)
         self.residuals: LivePlot | None = None
         self._update()  # built outside a held document: held, the new panes are laid out wrong
 
@@ -131,6 +132,9 @@ class MeasuredView(PlotView):
         r = s.fit_result
         self.use.disabled = self.download.disabled = r is None
         self.results.object = self._results_table(r) if r is not None else ""
+        data = curves.prediction_misfit(r, s.measured)
+        self.prediction.visible = data is not None
+        self.prediction.object = None if data is None else plots.prediction_overlay(data, self.dims_for(s.design.mode))
 
     def _draw(self, points, residuals):
         mode = self.state.design.mode
@@ -187,7 +191,7 @@ class MeasuredView(PlotView):
                 "errors and 95 % intervals, and says which parameters the data cannot determine; "
                 "then take the fitted design into the explorer or save it.",
                 sizing_mode="stretch_width"),
-            pn.Row(pn.Column("**Stiffness CSV**", self.stiffness_file, sizing_mode="stretch_width"),
+            pn.Row(pn.Column("**Stiffness CSV** (one or several)", self.stiffness_file, sizing_mode="stretch_width"),
                    pn.Column("**Loop CSV** (optional)", self.loop_file, sizing_mode="stretch_width"),
                    sizing_mode="stretch_width"),
             pn.Row(self.example, self.clear),
@@ -197,6 +201,7 @@ class MeasuredView(PlotView):
             pn.Row(self.fit_button, self.use),
             self.download,
             self.results,
+            self.prediction,
             self.residuals.grid(2),
             sizing_mode="stretch_width",
         )

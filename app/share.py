@@ -39,7 +39,7 @@ class ExportView(pn.viewable.Viewer):
             color="default", sizing_mode="stretch_width",
         )
         self.tool_format = pn.widgets.Select(
-            name="For multibody and FE tools", options=list(TOOL_FORMATS), value="Nastran bulk data (PBUSH)",
+            label="For multibody and FE tools", options=list(TOOL_FORMATS), value="Nastran bulk data (PBUSH)",
             description="Every direction: over the sweep's frequency range (30 frequencies) at the operating "
             "amplitude and the Fletcher–Gent amplitudes; Adams: linearised at the operating point (docs/export.md).",
             sizing_mode="stretch_width")

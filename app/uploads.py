@@ -26,7 +26,7 @@ def csv_dropper(multiple: bool = False) -> pn.widgets.FileDropper:
     return pn.widgets.FileDropper(
         accepted_filetypes=[".csv", "text/csv", "text/plain"], max_file_size=LIMIT, chunk_size=CHUNK_BYTES,
         multiple=multiple, max_files=MAX_FILES if multiple else None, previews=[], layout="compact",
-        sizing_mode="stretch_width", height=90,
+        sizing_mode="stretch_width", **({"min_height": 90} if multiple else {"height": 90}),  # a list grows
     )
 
 

@@ -9,7 +9,7 @@ import pytest
 from app.cli import main
 from core import PAPER_B, write_design
 from core.data import DataError, MeasuredStiffness, combined, parse_stiffness
-from core.fit import fit_global, parameter_values, predicted, selection
+from core.fit import fit_global, model_stiffness, parameter_values, predicted, selection
 from core.synthetic import synthetic_stiffness
 
 NOISE = 0.005
@@ -123,6 +123,13 @@ def test_the_explorer_reads_several_files_and_predicts_the_other_modes():
     assert r.prediction["points_fitted"] == 30 and r.prediction["gap_held_out"] < 3 * NOISE
     assert "**Fitted on mode=axial** (30 points)" in app.measured.results.object
     assert "| radial | " in app.measured.results.object and "predicted" in app.measured.results.object
+    assert app.measured.prediction.visible
+    shown = {el.label: el for el in app.measured.prediction.object}
+    assert set(shown) == {"axial, fitted", "radial, predicted"}
+    read = s.measured.select(s.measured.mode == "radial")  # as read from the file
+    k = model_stiffness(r.design, read)
+    np.testing.assert_allclose(np.sort(shown["radial, predicted"].dimension_values(1)),
+                               np.sort(100 * (np.abs(k) / np.abs(read.stiffness) - 1)), rtol=1e-9)
     s.fit_on = "mode=shear"
     s.run_fit()
     assert "chooses none" in s.data_message
