@@ -215,6 +215,16 @@ def option_cases(folder: Path, design: Path, measured: Path) -> list[Case]:
         "serve --port 70000": ("serve", "--port", "70000"),
         "serve --port -1": ("serve", "--port", "-1"),
         "an unknown option": ("loop", d, "--freq", "1", "--amp", "1e-3", "--colour", "red"),
+        "card without --amp-rad": ("card", d, "--freq", "10", "--amp-mm", "0.1"),
+        "card at 1e300 mm": ("card", d, "--freq", "10", "--amp-mm", "1e300", "--amp-rad", "0.01"),
+        "export, an unknown format": ("export", d, "--format", "abaqus", "--freq", "1", "10", "2", "--amp", "1e-4"),
+        "export, a million points": ("export", d, "--format", "table", "--freq", "1", "10", "100000", "--amp",
+                                     *["1e-4"] * 11),
+        "export at 1e300 m": ("export", d, "--format", "nastran", "--freq", "1", "10", "2", "--amp", "1e300"),
+        "fit on nothing": ("fit", m, "--design", d, "--fit-on", "mode=axial,amplitude=7"),
+        "fit on a bad key": ("fit", m, "--design", d, "--fit-on", "colour=red"),
+        "fit on a huge selection text": ("fit", m, "--design", d, "--fit-on", "mode=" + "+".join(["axial"] * 5000)),
+        "fit with 25 files": ("fit", *[m] * 25, "--design", d),
         "a number with underscores": ("loop", d, "--freq", "1_0", "--amp", "1e-3"),
     }
     return [Case(f"options: {name}", tuple(argv)) for name, argv in argvs.items()]
