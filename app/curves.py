@@ -174,19 +174,11 @@ def padded(values, log: bool = False, pad: float = PADDING) -> tuple[float, floa
 DISPLAY_POINTS = 5000
 
 
-def in_mode(measured: MeasuredStiffness | None, mode: str) -> MeasuredStiffness | None:
-    """The rows of ``measured`` in ``mode`` (all of a file without a mode column); None if none."""
-    if measured is None or measured.mode is None:
-        return measured
-    rows = measured.mode == mode
-    return measured.select(rows) if rows.any() else None
-
-
 def measured_points(measured: MeasuredStiffness | None, mode: str) -> dict | None:
     """Measured stiffness (SI) in display units, as the sweep plots draw it (dense data as the
     means of at most :data:`DISPLAY_POINTS` bins, :meth:`MeasuredStiffness.binned`); only the
     rows in ``mode``."""
-    measured = in_mode(measured, mode)
+    measured = None if measured is None else measured.of_mode(mode)
     if measured is None:
         return None
     measured = measured.binned(DISPLAY_POINTS)
@@ -200,7 +192,7 @@ def measured_residuals(design: Design, measured: MeasuredStiffness) -> dict | No
     """``design`` at each measured point against the data: |K| in %, the loss factor (at the
     points :func:`measured_points` draws), the gap (over every measured point); the rows in the
     design's mode only (None if there are none)."""
-    measured = in_mode(measured, design.mode)
+    measured = measured.of_mode(design.mode)
     if measured is None:
         return None
     k = stiffness_points(design, measured.frequency_hz, measured.amplitude)

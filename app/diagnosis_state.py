@@ -3,8 +3,6 @@ plots' data. No Panel import: the view (:mod:`app.diagnosis`) is thin."""
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import param
 
@@ -79,13 +77,10 @@ class DiagnosisState(param.Parameterized):
         if not self.baseline:
             raise ValueError("choose at least one baseline branch")
         design = self.explorer.design.replace(effects={})
-        data = self.data
-        if data.mode is not None:  # one direction at a time: the explorer's
-            rows = data.mode == design.mode
-            if not rows.any():
-                raise ValueError(f"the data hold no {design.mode} rows (they hold {', '.join(sorted(set(data.mode)))}): "
-                                 "switch the explorer's mode")
-            data = dataclasses.replace(data.select(rows), mode=None)
+        data = self.data.of_mode(design.mode)  # one direction at a time: the explorer's
+        if data is None:
+            raise ValueError(f"the data hold no {design.mode} rows (they hold {', '.join(sorted(set(self.data.mode)))}): "
+                             "switch the explorer's mode")
         return diagnose(design, data, baseline=[b for b in BRANCHES if b in self.baseline], progress=progress)
 
     def use_final(self):

@@ -69,6 +69,7 @@ class MeasuredView(PlotView):
         self.summary = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.results = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.prediction = pn.pane.HoloViews(None, sizing_mode="stretch_width", visible=False, linked_axes=False)
+        self._prediction_key = None
         self.residuals: LivePlot | None = None
         self._update()  # built outside a held document: held, the new panes are laid out wrong
 
@@ -118,7 +119,7 @@ class MeasuredView(PlotView):
                     f"{points['amplitude'].max():.3g} {s.amplitude_unit}; gap of the current design: "
                     f"**{residuals['gap']:.4f}**"
                     + (f" (drawn as {len(points['frequency_hz'])} bin means; fits bin them too)"
-                       if len(points["frequency_hz"]) < len(curves.in_mode(d, s.design.mode)) else ""))
+                       if len(points["frequency_hz"]) < len(d.of_mode(s.design.mode)) else ""))
         if s.measured_loop is not None:
             f, amp, _ = s.measured_loop.harmonic()
             lines.append(f"**Loop**: {s.measured_loop.time_s.size} samples at {f:.3g} Hz, amplitude "
@@ -132,9 +133,12 @@ class MeasuredView(PlotView):
         r = s.fit_result
         self.use.disabled = self.download.disabled = r is None
         self.results.object = self._results_table(r) if r is not None else ""
-        data = curves.prediction_misfit(r, s.measured)
-        self.prediction.visible = data is not None
-        self.prediction.object = None if data is None else plots.prediction_overlay(data, self.dims_for(s.design.mode))
+        key = (id(r), id(s.measured))  # depends on the fit and the data only, not on the design shown
+        if key != self._prediction_key:
+            self._prediction_key = key
+            data = curves.prediction_misfit(r, s.measured)
+            self.prediction.visible = data is not None
+            self.prediction.object = None if data is None else plots.prediction_overlay(data)
 
     def _draw(self, points, residuals):
         mode = self.state.design.mode

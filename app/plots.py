@@ -519,9 +519,10 @@ def card_plots(design: Design, frequency_hz: float = 10.0, displacement: float =
     return sized(hv.Layout(list(card_overlays(data, card_dimensions(), at).values())).cols(2), width)
 
 
-def prediction_overlay(data: dict, dims: dict) -> hv.Overlay:
+def prediction_overlay(data: dict) -> hv.Overlay:
     """A fit on a subset predicting the rest (:func:`app.curves.prediction_misfit`): the |K|
     misfit of every mode against frequency, fitted rows filled, predicted rows hollow."""
+    xdim = dimensions("axial")["frequency"]  # the same in every mode
     ydim = hv.Dimension("prediction_misfit", label="|K|, model − measured", unit="%")
     items = []
     for mode, parts in data.items():
@@ -529,6 +530,6 @@ def prediction_overlay(data: dict, dims: dict) -> hv.Overlay:
         for which, fill in (("fitted", 0.8), ("predicted", 0.0)):
             part = parts[which]
             if len(part["frequency_hz"]):
-                items.append(_points(part["frequency_hz"], part["misfit_pct"], dims["frequency"], ydim,
+                items.append(_points(part["frequency_hz"], part["misfit_pct"], xdim, ydim,
                                      f"{mode}, {which}", color=color, fill_alpha=fill, line_color=color, size=6))
     return _overlay(items, "Fitted and predicted rows, every mode: |K| misfit", "bushing-prediction", height=300)

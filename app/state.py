@@ -229,11 +229,7 @@ class ExplorerState(param.Parameterized):
 
     def load_measured(self, content: bytes | str, filename: str = "stiffness file") -> bool:
         """Read a measured-stiffness CSV (docs/files.md); on a bad file say why and keep the last."""
-        data, self.data_message = read_measured(parse_stiffness, content, filename)
-        if data is None:
-            return False
-        self.param.update(measured=data, fit_result=None)
-        return True
+        return self.load_measured_files({filename: content})
 
     def load_measured_loop(self, content: bytes | str, filename: str = "loop file") -> bool:
         """Read a measured-loop CSV; the operating point moves to the loop's frequency and

@@ -50,17 +50,6 @@ def on_files(dropper: pn.widgets.FileDropper, load: Callable[[dict], object]) ->
 
 
 def on_upload(dropper: pn.widgets.FileDropper, load: Callable[[bytes | str, str], object]) -> None:
-    """Call ``load(content, filename)`` with each file dropped (the newest one when the drop
-    area replaces an earlier file; an empty file too: it gets its message). Removing a file
-    from the drop area leaves the data loaded."""
-    seen: dict[str, bytes | str] = {}  # what was loaded (FileDropper changes its dict in place)
-
-    def changed(event):
-        for name, content in event.new.items():
-            if seen.get(name) is not content:
-                seen.clear()
-                seen[name] = content
-                load(content, name)
-                return
-
-    dropper.param.watch(changed, "value")
+    """Call ``load(content, filename)`` with the file dropped (the newest one when the drop area
+    replaces an earlier file; an empty file too: it gets its message)."""
+    on_files(dropper, lambda files: load(*reversed(list(files.items())[-1])))

@@ -312,10 +312,13 @@ def _read_measured(paths: list[str], design):
 
     if len(paths) > MAX_MEASURED_FILES:
         raise InputError(f"bushing: at most {MAX_MEASURED_FILES} measured files, got {len(paths)}")
-    data = combined([read_stiffness(p) for p in paths], design.mode)
-    if len(data) > MAX_ROWS:
-        raise InputError(f"bushing: the measured files hold {len(data)} rows together; at most {MAX_ROWS}")
-    return data
+    parts, rows = [], 0
+    for path in paths:
+        parts.append(read_stiffness(path))
+        rows += len(parts[-1])
+        if rows > MAX_ROWS:
+            raise InputError(f"bushing: the measured files hold more than {MAX_ROWS} rows together")
+    return combined(parts, design.mode)
 
 
 def _cmd_fit(args) -> None:
@@ -375,7 +378,7 @@ def _cmd_diagnose(args) -> None:
                          f"at a time (found {', '.join(sorted(set(data.mode)))}): give one mode's rows")
     if data.mode is not None:
         design = design.in_mode(data.mode[0])
-        data = dataclasses.replace(data, mode=None)
+        data = data.of_mode(design.mode)
     result = diagnose(design, data, baseline=baseline, progress=Progress(sys.stderr))
     report = result.to_json()
     if args.predictions:

@@ -101,6 +101,17 @@ class MeasuredStiffness(ComplexStiffness):
         mode = None if self.mode is None else self.mode[mask]
         return MeasuredStiffness(self.frequency_hz[mask], self.amplitude[mask], self.stiffness[mask], count, mode)
 
+    def of_mode(self, mode: str) -> MeasuredStiffness | None:
+        """The rows in ``mode``, as data of one direction (no mode column); all rows of data
+        without a mode column; None if no row is in ``mode``."""
+        if self.mode is None:
+            return self
+        rows = self.mode == mode
+        if not rows.any():
+            return None
+        one = self.select(rows)
+        return MeasuredStiffness(one.frequency_hz, one.amplitude, one.stiffness, one.count)
+
     def modes(self, default: str) -> np.ndarray:
         """The mode of every row: the file's, or ``default`` (the design's) without a column."""
         return np.full(len(self), default, dtype=object) if self.mode is None else self.mode

@@ -146,13 +146,8 @@ def nastran(grid: dict, design: Design, first_id: int = 1) -> str:
             for tid, values in ((tk[d], k[mode].real), (tge[d], k[mode].imag / k[mode].real)):
                 pairs = [nastran_real(v) for xy in zip(f, values) for v in xy] + ["ENDT"]
                 lines += _card("TABLED1", [str(tid), "LINEAR", "LINEAR"])
-                lines += _table_lines(pairs)
+                lines += _card("", pairs)
     return "\n".join(lines) + "\n"
-
-
-def _table_lines(pairs: list[str]) -> list[str]:
-    """A table's x, y pairs on continuation lines, four pairs per line."""
-    return [f"{'':<8}" + "".join(f"{v:>8}" for v in pairs[s:s + 8]) for s in range(0, len(pairs), 8)]
 
 
 # ---- Adams ----------------------------------------------------------------------------------------

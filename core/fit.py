@@ -107,11 +107,10 @@ def check_data_amplitudes(design: Design, data: MeasuredStiffness) -> None:
         check_measured_amplitude(design.in_mode(mode), data.amplitude[data.mode == mode], f"{mode} amplitude")
 
 
-def gaps_by_mode(design: Design, data: MeasuredStiffness) -> dict[str, float]:
-    """The gap of each mode's rows (empty without a `mode` column)."""
+def gaps_by_mode(k: np.ndarray, data: MeasuredStiffness) -> dict[str, float]:
+    """The gap of each mode's rows of the model's K at ``data`` (empty without a `mode` column)."""
     if data.mode is None:
         return {}
-    k = model_stiffness(design, data)
     return {m: gap(k[data.mode == m], data.stiffness[data.mode == m],
                    None if data.count is None else data.count[data.mode == m])
             for m in np.unique(data.mode.astype(str))}
@@ -350,17 +349,18 @@ def _warnings(problem: _Problem, sol, intervals: dict, complete: bool) -> tuple[
     their fitting range, parameters the data do not determine, an unfinished profile."""
     lo, hi = problem.bounds()
     values = problem.values(sol.x)
-    out = []
+    out, at_edge = [], set()
     for i, (name, spec) in enumerate(zip(problem.free, problem.specs)):
         span = hi[i] - lo[i]
         edge = "lower" if sol.x[i] - lo[i] <= 1e-6 * span else "upper" if hi[i] - sol.x[i] <= 1e-6 * span else None
         if edge:
+            at_edge.add(name)
             unit = "" if spec.unit == "–" else f" {spec.unit}"
             out.append(f"{name} ran to the {edge} end of its fitting range ({values[name]:.3g}{unit}): "
                        f"the model cannot follow these data there; check that the design's mode and "
                        f"geometry are those of the measurement")
     for name, (a, b) in intervals.items():
-        if (a is None or b is None) and not any(w.startswith(f"{name} ran to") for w in out):
+        if (a is None or b is None) and name not in at_edge:
             unit = parameter(name).unit
             unit = "" if unit == "–" else f" {unit}"
             which = ("any value in its fitting range" if a is None and b is None
@@ -377,16 +377,16 @@ def _result(problem: _Problem, sol, method: str, starts: int, design: Design, in
     errors, corr, _ = _uncertainties(problem, sol)
     fitted = problem.model(sol.x)
     fitted = fitted.replace(name=fitted_name(design.name))
-    g = float("nan")
+    g, by_mode = float("nan"), {}
     data, loop = problem.full_data, problem.full_loop  # every measured point, binned or not
     if data is not None:
-        g = gap(model_stiffness(fitted, data), data.stiffness, data.count)
+        k = model_stiffness(fitted, data)
+        g, by_mode = gap(k, data.stiffness, data.count), gaps_by_mode(k, data)
     loop_rms = None
     if loop is not None:
         f = sum(loop_force(fitted, problem.loop_f, problem.loop_amp, loop.harmonic()[2]))
         loop_rms = float(np.sqrt(np.mean((f - (loop.force - np.mean(loop.force))) ** 2)) / problem.loop_scale)
     n = 0 if data is None else data.measured_points
-    by_mode = {} if data is None else gaps_by_mode(fitted, data)
     return FitResult(fitted, errors, corr, g, float(sol.cost), n, method, starts, loop_rms,
                      intervals=intervals or {}, warnings=tuple(warnings), gap_by_mode=by_mode)
 

@@ -37,7 +37,7 @@ from __future__ import annotations
 import functools
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -49,7 +49,6 @@ SHAPES = ("long", "finite")  # closed forms of long bushings, or the finite-leng
 DEFAULT_SHAPE = {"axial": "long", "torsion": "long", "radial": "finite", "conical": "finite"}
 TABLE_PATH = Path(__file__).with_name("shape_table.json")
 BULK_RATIO = 5000.0  # K/µ of the FE model: rubber's is 1 000–5 000
-VERBOSE = 0
 
 
 class OutsideTable(ValueError):
@@ -166,7 +165,7 @@ def fe_shape_factor(a: float, b: float, L: float, mode: str, n_r: int = 6) -> tu
     ext0 = fem.dof.apply(field, boundaries, dof0)
     # the problem is linear (a step of 1e-6 of the wall): Newton converges in one or two
     # iterations to the round-off floor of the nearly incompressible system (about 1e-8)
-    res = fem.newtonraphson(items=[solid], x0=field, dof1=dof1, dof0=dof0, ext0=ext0, verbose=VERBOSE, tol=1e-6)
+    res = fem.newtonraphson(items=[solid], x0=field, dof1=dof1, dof0=dof0, ext0=ext0, verbose=0, tol=1e-6)
     # the quarter's reaction on the inner tube, times 4 (the other quarters mirror it)
     if mode in TRANSLATIONS:
         force = fem.tools.force(field, res.fun, boundaries["inner"])
@@ -206,6 +205,7 @@ class ShapeTable:
     radius_ratio: np.ndarray  # b/a
     length_ratio: np.ndarray  # L/(b − a)
     ratios: dict  # mode → array (radius_ratio × length_ratio) of S_FE / S_reference
+    splines: dict = field(default_factory=dict)  # mode → bicubic spline of ln(ratio) in the logarithms
 
     def ratio(self, mode: str, radius_ratio: float, length_ratio: float) -> float:
         lo_r, hi_r = self.radius_ratio[[0, -1]]
@@ -216,24 +216,19 @@ class ShapeTable:
                 f"this bushing has b/a {radius_ratio:.3g} and L/(b − a) {length_ratio:.3g} (use shape 'long' "
                 f"for axial or torsion)")
         # the spline interpolates ln(ratio): its exp stays positive and smooth
-        return math.exp(float(self._spline(mode)(math.log(radius_ratio), math.log(length_ratio))[0, 0]))
-
-    @functools.cache  # noqa: B019 - one table per process, a spline per mode
-    def _spline(self, mode: str):
-        from scipy.interpolate import RectBivariateSpline
-
-        return RectBivariateSpline(np.log(self.radius_ratio), np.log(self.length_ratio),
-                                   np.log(self.ratios[mode]), kx=3, ky=3, s=0)
-
-    def __hash__(self):
-        return id(self)
+        return math.exp(float(self.splines[mode](math.log(radius_ratio), math.log(length_ratio))[0, 0]))
 
 
 @functools.cache
 def table() -> ShapeTable:
+    """The shipped table, read and its splines built once per process."""
+    from scipy.interpolate import RectBivariateSpline
+
     data = json.loads(TABLE_PATH.read_text(encoding="utf-8"))
-    return ShapeTable(np.array(data["radius_ratio"]), np.array(data["length_ratio"]),
-                      {m: np.array(v) for m, v in data["ratios"].items()})
+    q, lam = np.array(data["radius_ratio"]), np.array(data["length_ratio"])
+    ratios = {m: np.array(v) for m, v in data["ratios"].items()}
+    splines = {m: RectBivariateSpline(np.log(q), np.log(lam), np.log(r), kx=3, ky=3, s=0) for m, r in ratios.items()}
+    return ShapeTable(q, lam, ratios, splines)
 
 
 def finite_shape_factor(a: float, b: float, L: float, mode: str) -> float:
