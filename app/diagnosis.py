@@ -160,7 +160,7 @@ class DiagnosisView(pn.viewable.Viewer):
             self.report.object = ""
             return
         self.report.object = self._report_text(r)
-        self._draw(r)
+        self._draw(s.shown())
 
     def _report_text(self, r) -> str:
         noise = f"{r.noise_gap:.4f}" if r.noise_gap is not None else "not estimable"
@@ -177,15 +177,29 @@ class DiagnosisView(pn.viewable.Viewer):
                                for k, v in step.parameters.items()) or "no parameters"
             partner = step.extra.get("found_with")
             together = f" (found together with {partner})" if partner else ""
-            lines.append(f"**Step {n}: add {EFFECTS[step.effect].title}**{together}: {params}. Evidence: BIC "
+            support = step.support_words()
+            lines.append(f"**Step {n}: add {EFFECTS[step.effect].title}**{together}"
+                         f"{' *' + support + '*' if step.mode else ''}: {params}. Evidence: BIC "
                          f"drop **{step.bic_drop:.1f}** (threshold {BIC_THRESHOLD:g}); gap "
-                         f"{step.gap_before:.4f} → **{step.gap_after:.4f}**.")
+                         f"{step.gap_before:.4f} → **{step.gap_after:.4f}**"
+                         + (f"; {support}" if support and not step.mode else "") + ".")
             lines.append("> " + _effect_card(step.effect))
             others = sorted(((v, k) for k, v in step.candidates.items() if k != step.effect), reverse=True)[:3]
             if others:
                 lines.append("Other candidates' BIC drops: " + ", ".join(f"{k} {v:.1f}" for v, k in others) + ".")
         if not r.steps:
             lines.append("**Nothing added**: no effect of the library is supported by the data.")
+        if r.modes:
+            joint = ", ".join(f"{m} {g:.4f}" for m, g in r.modes["gap_joint_by_mode"].items())
+            alone = ", ".join(f"{m} {g:.4f}" for m, g in r.modes["gap_alone_by_mode"].items())
+            if r.modes_disagree:
+                lines.append(f"**The modes disagree**: one material does not describe them together. Gap by "
+                             f"mode {joint} jointly, {alone} with each mode fitted alone (BIC drop "
+                             f"{r.modes['bic_drop']:.1f} for a material per mode). Check that every part is of "
+                             f"one compound, and each rig's geometry and calibration.")
+            else:
+                lines.append(f"**The modes agree**: one material describes them all (gap by mode {joint}).")
+            lines.append(f"*The plots show the {r.final.design.mode} rows; the report covers every mode.*")
         if r.unexplained:
             lines.append("**Unexplained**: a misfit above the noise remains that no effect of the library "
                          f"explains: {r.where_remaining}")

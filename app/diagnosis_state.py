@@ -77,11 +77,17 @@ class DiagnosisState(param.Parameterized):
         if not self.baseline:
             raise ValueError("choose at least one baseline branch")
         design = self.explorer.design.replace(effects={})
-        data = self.data.of_mode(design.mode)  # one direction at a time: the explorer's
-        if data is None:
+        if self.data.of_mode(design.mode) is None:
             raise ValueError(f"the data hold no {design.mode} rows (they hold {', '.join(sorted(set(self.data.mode)))}): "
                              "switch the explorer's mode")
+        data = self.data  # every mode at once: one material, each mode through its shape factor
+        if data.mode is not None and len(set(data.mode)) == 1:
+            data = data.of_mode(design.mode)
         return diagnose(design, data, baseline=[b for b in BRANCHES if b in self.baseline], progress=progress)
+
+    def shown(self) -> Diagnosis | None:
+        """The result as the plots show it: the rows of the mode it was run in."""
+        return None if self.result is None else self.result.of_mode(self.result.final.design.mode)
 
     def use_final(self):
         """Take the final model into the explorer, keeping the operating point."""
@@ -120,12 +126,12 @@ class DiagnosisState(param.Parameterized):
 
     def misfit(self, which: str) -> dict:
         """Model − data over the (frequency, amplitude) plane: |K| in %, loss factor."""
-        return curves.misfit_points(self.result, which)
+        return curves.misfit_points(self.shown(), which)
 
     def curves(self) -> dict:
         """Data and both models against frequency, one group per measured amplitude (the most
         populated five), display units."""
-        return {"groups": curves.curve_groups(self.result)}
+        return {"groups": curves.curve_groups(self.shown())}
 
     # ---- downloads -----------------------------------------------------------------------------
 

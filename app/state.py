@@ -221,7 +221,7 @@ class ExplorerState(param.Parameterized):
         self._loaded = [design]
         self.param.update(
             **_display_values(design),
-            effects=design.effect_parameters,
+            effects=design.portable_effects,  # a rig's mass stays with its mode
             amplitude=float(f"{x_mid:.3g}"),
         )
 

@@ -158,7 +158,8 @@ def modulus_function(design: Design, route: str = "analytic"):
         return functools.partial(mat.equivalent_modulus, design.material)
     if route == "time-domain":
         # the time-domain route simulates the material-level effects itself
-        return functools.partial(_modulus_time_domain, design.material, design.effects)
+        return functools.partial(_modulus_time_domain, design.material,
+                                 tuple((e, p) for e, p in design.effects if "@" not in e))
     raise ValueError(f"route: must be one of {', '.join(ROUTES)}, got {route!r}")
 
 

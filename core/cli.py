@@ -373,10 +373,7 @@ def _cmd_diagnose(args) -> None:
                          f"got {args.baseline!r}")
     design = read_design(args.design)
     data = _read_measured(args.measured, design)
-    if data.mode is not None and len(set(data.mode)) > 1:
-        raise InputError("bushing diagnose: the data hold several modes; the diagnosis works on one direction "
-                         f"at a time (found {', '.join(sorted(set(data.mode)))}): give one mode's rows")
-    if data.mode is not None:
+    if data.mode is not None and len(set(data.mode)) == 1:  # one direction: the design in it
         design = design.in_mode(data.mode[0])
         data = data.of_mode(design.mode)
     result = diagnose(design, data, baseline=baseline, progress=Progress(sys.stderr))

@@ -141,7 +141,9 @@ class Design:
 
     ``effects`` holds the model extensions of the discrepancy workflow (docs/model.md's table,
     :mod:`core.effects`); pass a mapping ``{effect_id: {parameter: value}}``: it is validated
-    and frozen into a hashable tuple.
+    and frozen into a hashable tuple. An effect of the test rig (an apparent mass) acts in the
+    design's mode only; one measured on another mode's rig is kept as ``id@mode`` and acts when
+    the design is taken into that mode (:meth:`in_mode`).
     """
 
     mode: str
@@ -164,13 +166,26 @@ class Design:
             raise DesignError("material", "must be a Material")
         if self.name is not None and not isinstance(self.name, str):
             raise DesignError("name", f"must be a string, got {self.name!r}")
-        object.__setattr__(self, "effects", _frozen_effects(self.effects))
+        effects = _frozen_effects(self.effects)
+        own = f"@{self.mode}"
+        if any(eid.endswith(own) for eid, _ in effects):  # tied to this design's own mode: plain
+            ids = [eid.removesuffix(own) for eid, _ in effects]
+            twice = sorted({i for i in ids if ids.count(i) > 1})
+            if twice:
+                raise DesignError(f"effects.{twice[0]}{own}", f"{twice[0]} is given for the {self.mode} "
+                                                             f"mode twice (with and without {own})")
+            effects = tuple(sorted((eid.removesuffix(own), p) for eid, p in effects))
+        object.__setattr__(self, "effects", effects)
 
     def in_mode(self, mode: str) -> Design:
         """This bushing and material in another direction: the same ``shape`` where the mode
-        allows it (conical has no long form: its default then)."""
+        allows it (conical has no long form: its default then). Effects of the rubber go with
+        it; an effect of this mode's test rig stays with this mode (as ``id@mode``) and one tied
+        to ``mode`` acts."""
         shape = None if (mode == "conical" and self.shape == "long") else self.shape
-        return self if (mode, shape) == (self.mode, self.shape) else self.replace(mode=mode, shape=shape)
+        if (mode, shape) == (self.mode, self.shape):
+            return self
+        return self.replace(mode=mode, shape=shape, effects=self.portable_effects)
 
     @property
     def shape_kind(self) -> str:
@@ -179,6 +194,21 @@ class Design:
 
     @property
     def effect_parameters(self) -> dict[str, dict[str, float]]:
+        """The effects acting in this design's mode, by id."""
+        return {eid: dict(params) for eid, params in self.effects if "@" not in eid}
+
+    @property
+    def portable_effects(self) -> dict[str, dict[str, float]]:
+        """Every effect, this mode's rig effects tied to it (``id@mode``): what a design of any
+        mode built from them carries (the tie to its own mode falls away)."""
+        from .effects import EFFECTS
+
+        return {(f"{eid}@{self.mode}" if "@" not in eid and EFFECTS[eid].rig else eid): dict(p)
+                for eid, p in self.effects}
+
+    @property
+    def every_effect(self) -> dict[str, dict[str, float]]:
+        """Every effect the design carries, those tied to other modes' rigs (``id@mode``) too."""
         return {eid: dict(params) for eid, params in self.effects}
 
     def replace(self, **changes) -> Design:
@@ -204,7 +234,7 @@ class Design:
         out["geometry"] = as_dict(self.geometry)
         out["material"] = as_dict(self.material)
         if self.effects:
-            out["effects"] = self.effect_parameters
+            out["effects"] = self.every_effect
         return out
 
 

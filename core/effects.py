@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 from scipy import special
 
-from .design import DesignError, Material, _number
+from .design import MODES, DesignError, Material, _number
 from .material import REFERENCE_FREQUENCY_HZ, fractional_modulus, friction_modulus
 
 
@@ -46,6 +46,9 @@ class Effect:
     branch: bool = False  # one of the thesis' own branches (parameters live in `material`)
     requires: tuple[str, ...] = ()  # acts only on one of these (branches or effects)
     excludes: tuple[str, ...] = ()  # cannot be combined with these effects
+    # lives on one test rig, not in the rubber: it acts in the mode it was measured in only (a
+    # design file writes it for another mode as ``id@mode``, :func:`split_id`)
+    rig: bool = False
     # a material-level effect's frequency-domain term: (material, its parameters, f in Hz, ε̂,
     # the thesis' own branch moduli) → (the branch it enters, what it adds to that branch's
     # modulus µ_eq, in Pa). The one
@@ -112,6 +115,7 @@ EFFECTS: dict[str, Effect] = {
             "accelerated with the drive; its inertial force adds to the rubber's.",
             "Measured stiffness falls below the model more and more at high frequency, as ω², "
             "the same at every amplitude; the loss factor rises with it.",
+            rig=True,
         ),
         Effect(
             "viscous",
@@ -170,20 +174,41 @@ EFFECTS: dict[str, Effect] = {
 }
 
 
+def split_id(eid: str) -> tuple[str, str | None]:
+    """An effect id of a design file and the mode it is tied to: ``inertia@torsion`` is the
+    apparent mass of the torsion rig, carried by a design of another mode (``None``: the
+    design's own mode, or every mode for an effect of the rubber)."""
+    base, sep, mode = eid.partition("@")
+    return base, (mode if sep else None)
+
+
+def effect_of(eid: str) -> Effect:
+    """The library's effect behind an id, mode-tied or not (:func:`split_id`)."""
+    return EFFECTS[split_id(eid)[0]]
+
+
 def validate_effects(effects: Any) -> dict[str, dict[str, float]]:
     """Check an ``effects`` object of a design file; return it as plain floats.
 
     Refuses unknown ids, the branch ids (their parameters belong in ``material``), unknown or
-    missing parameters, non-numbers and negative values, naming the key.
+    missing parameters, non-numbers and negative values, naming the key. A rig effect may be
+    tied to another mode as ``id@mode``; an effect of the rubber may not.
     """
     if not isinstance(effects, Mapping):
         raise DesignError("effects", "must be an object mapping effect ids to their parameters")
     out: dict[str, dict[str, float]] = {}
     for eid, params in effects.items():
         key = f"effects.{eid}"
-        if eid not in EFFECTS:
+        base, mode = split_id(str(eid))
+        if base not in EFFECTS:
             raise DesignError(key, f"unknown effect (known: {', '.join(EFFECTS)})")
-        effect = EFFECTS[eid]
+        effect = EFFECTS[base]
+        if mode is not None and not effect.rig:
+            rigs = ", ".join(e.id for e in EFFECTS.values() if e.rig)
+            raise DesignError(key, f"only an effect of the test rig ({rigs}) can be tied to a mode; "
+                                   f"{base} is the rubber's and acts in every mode")
+        if mode is not None and mode not in MODES:
+            raise DesignError(key, f"the mode after @ must be one of {', '.join(MODES)}, got {mode!r}")
         if effect.branch:
             raise DesignError(
                 key, "is a branch of the material model; its parameters belong in material"

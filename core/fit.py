@@ -35,7 +35,7 @@ from scipy.optimize import least_squares
 from .bushing import check_measured_amplitude, loop_force, stiffness_points
 from .data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from .design import Design, as_dict
-from .effects import EFFECTS, Parameter
+from .effects import EFFECTS, Parameter, split_id
 from .uncertainty import CONFIDENCE, profile
 
 PARAMETERS = (
@@ -55,7 +55,8 @@ def parameter(name: str) -> Parameter:
     if name == "shear_modulus":
         return SHEAR_MODULUS
     eid, _, pname = name.rpartition(".")
-    owners = [EFFECTS[eid]] if eid in EFFECTS else [] if eid else [EFFECTS["friction"], EFFECTS["fractional"]]
+    base = split_id(eid)[0]
+    owners = [EFFECTS[base]] if base in EFFECTS else [] if eid else [EFFECTS["friction"], EFFECTS["fractional"]]
     for effect in owners:
         for p in effect.parameters:
             if p.name == pname:
@@ -77,7 +78,7 @@ def with_values(design: Design, values: dict[str, float]) -> Design:
     at every residual evaluation of a fit."""
     changes: dict = {k: v for k, v in values.items() if "." not in k}
     if len(changes) < len(values):
-        effects = design.effect_parameters
+        effects = design.every_effect
         for k, v in values.items():
             if "." in k:
                 eid, _, p = k.rpartition(".")

@@ -143,3 +143,31 @@ def test_progress_is_reported_while_fitting(app):
     assert fractions[0] == 0.0 and fractions[-1] == 1.0
     assert all(b >= a for a, b in itertools.pairwise(fractions))  # never backwards
     assert any("apparent mass" in m for _, m in seen)
+
+
+def test_data_of_two_modes_are_diagnosed_jointly_and_plotted_in_the_explorers_mode(app):
+    """An apparent mass on the axial rig only, with torsion data of the same compound: the tab
+    names it for the axial rig, says the modes agree, plots the explorer's mode's rows, and the
+    mass follows the design into the explorer, acting in axial only."""
+    from core.data import MeasuredStiffness, combined
+
+    parts = []
+    for mode, amps, effects in (("axial", AMPS, {"inertia": {"mass": 0.5}}), ("torsion", (1e-3, 1e-2), {})):
+        d = synthetic_stiffness(PAPER_B.in_mode(mode).replace(effects=effects), F, amps, seed=5)
+        parts.append(MeasuredStiffness(d.frequency_hz, d.amplitude, d.stiffness, None, np.full(len(d), mode, dtype=object)))
+    app.state.mode = "torsion"
+    state, view = app.diagnosis.state, app.diagnosis
+    assert state.load_csv(combined(parts, "axial").to_csv(), "two.csv")
+    run(app)
+    r = state.result
+    assert r.added == ["inertia"] and r.steps[0].mode == "axial" and not r.modes_disagree
+    assert "on the axial rig only" in view.report.object and "The modes agree" in view.report.object
+    assert "The plots show the torsion rows" in view.report.object
+    magnitude, _ = view.live["curves"].current  # torsion rows only, the final model in torsion
+    f, k = xy(magnitude, "0.01 rad final")
+    np.testing.assert_allclose(k, np.abs(stiffness_points(r.final.design, f, 1e-2)), rtol=1e-12)  # N·m/rad
+    assert len(view.live["maps"].current[2].get(0).dimension_values(0)) == len(F) * 2
+    state.use_final()
+    assert app.state.design.mode == "torsion" and app.state.design.effect_parameters == {}
+    app.state.mode = "axial"  # on its own rig the mass acts
+    assert app.state.design.effect_parameters["inertia"]["mass"] == pytest.approx(r.steps[0].parameters["mass"])

@@ -4,6 +4,7 @@ cross-mode prediction (fit on a subset, predict the rest), and the messages for 
 import json
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from app.cli import main
@@ -98,10 +99,14 @@ def test_the_command_line_fits_several_files_and_predicts(tmp_path, capsys):
     report = json.loads(capsys.readouterr().out)["fit"]
     assert report["points"] == 60 and report["prediction"]["points_fitted"] == 60
     assert report["prediction"]["gap_held_out"] < 3 * NOISE  # the axial file (no mode column: the design's)
-    with pytest.raises(SystemExit) as refused:
-        main([str(a) for a in ["diagnose", tmp_path / "axial.csv", tmp_path / "torsion.csv", "--design",
-                               tmp_path / "d.json"]])
-    assert refused.value.code == 2 and "several modes" in capsys.readouterr().err
+    argv = ["diagnose", tmp_path / "axial.csv", tmp_path / "torsion.csv", "--design", tmp_path / "d.json",
+            "--predictions", tmp_path / "pred.csv"]
+    assert main([str(a) for a in argv]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["added"] == [] and report["modes"]["disagree"] is False  # one material, to the noise
+    assert set(report["modes"]["gap_joint_by_mode"]) == {"axial", "torsion"}
+    pred = pd.read_csv(tmp_path / "pred.csv")
+    assert list(pred.columns[:2]) == ["mode", "frequency_hz"] and set(pred["mode"]) == {"axial", "torsion"}
 
 
 def test_the_explorer_reads_several_files_and_predicts_the_other_modes():

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -51,15 +51,44 @@ class Step:
     candidates: dict[str, float]  # every candidate's BIC drop at this step
     extra: dict = field(default_factory=dict)  # more evidence (the partner of a pair)
     standard_errors: dict[str, float] = field(default_factory=dict)  # of ``parameters``, linearised
+    mode: str | None = None  # data of several modes: the rig a rig effect (a mass) was found on
+    by_mode: dict = field(default_factory=dict)  # data of several modes: each mode's evidence
+
+    @property
+    def supported_by(self) -> list[str]:
+        return [m for m, e in self.by_mode.items() if e["verdict"] == "supports"]
 
     def report(self) -> dict:
         evidence = {"bic_drop": self.bic_drop, "candidates_bic_drop": self.candidates, **self.extra}
         if self.explained_fraction is not None:
             evidence["explained_fraction"] = self.explained_fraction
+        if self.by_mode:
+            evidence["by_mode"] = self.by_mode
         errors = {k: (v if math.isfinite(v) else None) for k, v in self.standard_errors.items()}
-        return {"effect": self.effect, "title": self.title, "where": self.where, "evidence": evidence,
-                "parameters": self.parameters, "standard_errors": errors, "gap_before": self.gap_before,
-                "gap_after": self.gap_after}
+        out = {"effect": self.effect, "title": self.title, "where": self.where, "evidence": evidence,
+               "parameters": self.parameters, "standard_errors": errors, "gap_before": self.gap_before,
+               "gap_after": self.gap_after}
+        if self.mode:
+            out["mode"] = self.mode
+        if self.by_mode:
+            out["supported_by"] = self.supported_by
+        return out
+
+    def support_words(self) -> str:
+        """Which modes' data support the step, in words ('' for data of one mode)."""
+        if self.mode:
+            return f"on the {self.mode} rig only"
+        if not self.by_mode:
+            return ""
+        groups = {v: [m for m, e in self.by_mode.items() if e["verdict"] == v] for v in ("supports", "neutral", "against")}
+        if len(groups["supports"]) == len(self.by_mode):
+            return "supported by every mode"
+        parts = [f"supported by {' and '.join(groups['supports'])}" if groups["supports"] else "no mode alone supports it"]
+        if groups["neutral"]:
+            parts.append(f"{' and '.join(groups['neutral'])} neither for nor against")
+        if groups["against"]:
+            parts.append(f"{' and '.join(groups['against'])} against it")
+        return "; ".join(parts)
 
 
 @dataclass(frozen=True)
@@ -73,6 +102,11 @@ class Diagnosis:
     where_baseline: str
     where_remaining: str
     held_out: dict = field(default_factory=dict)
+    modes: dict = field(default_factory=dict)  # data of several modes: one material or one per mode
+
+    @property
+    def modes_disagree(self) -> bool:
+        return bool(self.modes.get("disagree"))
 
     @property
     def added(self) -> list[str]:
@@ -103,6 +137,8 @@ class Diagnosis:
             out["baseline_effects"] = [eid for eid, _ in self.baseline.design.effects]
         if self.held_out:
             out["held_out"] = self.held_out
+        if self.modes:
+            out["modes"] = self.modes
         fit = self.final.fit.report()
         if "intervals" in fit:
             out["uncertainty"] = {k: fit[k] for k in ("confidence", "intervals", "undetermined")}
@@ -113,10 +149,25 @@ class Diagnosis:
         """The report as JSON text (strict: no NaN)."""
         return json.dumps(self.report(), indent=2, allow_nan=False) + "\n"
 
+    def of_mode(self, mode: str) -> Diagnosis:
+        """The diagnosis seen on one mode's rows (for plots of one direction): its data and both
+        models' stiffness there, the models in that mode. The evidence stays the joint one."""
+        if self.data.mode is None:
+            return self
+        rows = self.data.mode == mode
+
+        def part(f: Fitted) -> Fitted:
+            fit = replace(f.fit, design=f.fit.design.in_mode(mode))
+            return replace(f, fit=fit, stiffness=f.stiffness[rows], residual=f.residual[rows])
+
+        return replace(self, data=self.data.of_mode(mode), baseline=part(self.baseline), final=part(self.final))
+
     def predictions(self) -> dict[str, np.ndarray]:
-        """Per data row: the baseline's and the final model's |K| and loss factor."""
+        """Per data row: the baseline's and the final model's |K| and loss factor (and the
+        row's mode first, for data with a `mode` column)."""
         kb, kf = self.baseline.stiffness, self.final.stiffness
         return {
+            **({} if self.data.mode is None else {"mode": self.data.mode}),
             "frequency_hz": self.data.frequency_hz,
             "amplitude": self.data.amplitude,
             "baseline_magnitude": np.abs(kb),
@@ -135,10 +186,23 @@ def summary(diagnosis: Diagnosis) -> str:
     for n, s in enumerate(diagnosis.steps, 1):
         params = ", ".join(f"{k} = {v:.4g}" + (f" ± {s.standard_errors[k]:.2g}" if math.isfinite(s.standard_errors.get(k, math.nan)) else "")
                            for k, v in s.parameters.items()) or "no parameters"
-        lines.append(f"step {n}: add {s.effect} ({s.title}): {params}; BIC drop {s.bic_drop:.1f}; "
-                     f"gap {s.gap_before:.4g} -> {s.gap_after:.4g}")
+        support = s.support_words()
+        lines.append(f"step {n}: add {s.effect} ({s.title}){' ' + support if s.mode else ''}: {params}; "
+                     f"BIC drop {s.bic_drop:.1f}; gap {s.gap_before:.4g} -> {s.gap_after:.4g}"
+                     + (f"; {support}" if support and not s.mode else ""))
     if not diagnosis.steps:
         lines.append("no effect of the library is needed: nothing added")
+    modes = diagnosis.modes
+    if modes:
+        joint = ", ".join(f"{m} {g:.3g}" for m, g in modes["gap_joint_by_mode"].items())
+        alone = ", ".join(f"{m} {g:.3g}" for m, g in modes["gap_alone_by_mode"].items())
+        if modes["disagree"]:
+            lines.append(f"the modes disagree: one material does not describe them together (gap by mode "
+                         f"{joint}; each mode fitted alone {alone}; BIC drop {modes['bic_drop']:.1f} for a "
+                         f"material per mode): check that every part is of one compound and every rig's "
+                         f"geometry and calibration")
+        else:
+            lines.append(f"the modes agree: one material describes them all (gap by mode {joint})")
     if diagnosis.unexplained:
         lines.append(f"unexplained: a misfit above the noise remains, no effect of the library explains it: "
                      f"{diagnosis.where_remaining}")

@@ -9,15 +9,31 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..bushing import stiffness_points
 from ..data import MAX_FIT_POINTS, MeasuredStiffness
 from ..design import Design
-from ..effects import EFFECTS
-from ..fit import fit_global, gap, parameter, parameter_values, relative_residual
+from ..effects import effect_of, split_id
+from ..fit import (
+    fit_global,
+    gap,
+    gaps_by_mode,
+    model_stiffness,
+    parameter,
+    parameter_values,
+    relative_residual,
+)
 from ..material import ConvergenceError
-from .model import BRANCHES, Model, baseline_model, candidates
+from .model import BRANCHES, Model, baseline_model, candidates, fitting_names
 from .report import Diagnosis, Fitted, Step
-from .statistics import BIC_THRESHOLD, NOISE_RATIO, bic, explains, lower, noise_variance, runs
+from .statistics import (
+    BIC_THRESHOLD,
+    NOISE_RATIO,
+    PRECISION,
+    bic,
+    explains,
+    lower,
+    noise_variance,
+    runs,
+)
 from .words import describe
 
 PAIR_POOL = 4  # pairs are sought among the four best single candidates
@@ -43,7 +59,7 @@ class Accepted:
 
 def _fit(model: Model, data: MeasuredStiffness, **kwargs) -> Fitted:
     result = fit_global(model.design, data, free=model.free, **{"intervals": False, **kwargs})
-    k = stiffness_points(result.design, data.frequency_hz, data.amplitude)
+    k = model_stiffness(result.design, data)
     residual = relative_residual(k, data.stiffness) * data.weight  # binned data: one point's noise
     return Fitted(Model(result.design, model.branches), result, k, residual, bic(residual, len(model.free)))
 
@@ -61,8 +77,7 @@ def _grid_values(names: list[str], n: int) -> list[dict[str, float]]:
 def _candidate_starts(current: Fitted, effect_id: str, data: MeasuredStiffness, keep: int = 2):
     """Starting values for a candidate's parameters: the best ``keep`` of a grid across their
     fitting ranges, the rest of the model held at its fitted values."""
-    effect = EFFECTS[effect_id]
-    names = [effect.fitting_name(p.name) for p in effect.parameters]
+    names = fitting_names(effect_id)
     if not names:
         return [{}]
     grid = _grid_values(names, GRID_1D if len(names) == 1 else GRID_2D)
@@ -70,7 +85,7 @@ def _candidate_starts(current: Fitted, effect_id: str, data: MeasuredStiffness, 
     for values in grid:
         trial = current.model.add(effect_id, {n.rpartition(".")[2]: v for n, v in values.items()})
         try:
-            k = stiffness_points(trial.design, data.frequency_hz, data.amplitude)
+            k = model_stiffness(trial.design, data)
         except (ValueError, ArithmeticError, ConvergenceError):
             continue
         r = relative_residual(k, data.stiffness) * data.weight
@@ -122,22 +137,22 @@ def _held_out(data: MeasuredStiffness, fits: dict[str, Fitted]) -> dict:
                                    intervals=False)
             except (ValueError, ArithmeticError, ConvergenceError):
                 return {}  # too few points left to refit on: no held-out figure
-            predicted[held] = stiffness_points(refit.design, data.frequency_hz[held], data.amplitude[held])
+            predicted[held] = model_stiffness(refit.design, data.select(held))
         out[f"gap_{label}"] = done[id(fitted)] = gap(predicted, data.stiffness)
     return out
 
 
 def _best_pair(current: Fitted, tried: dict[str, Fitted], drops: dict[str, float],
-               data: MeasuredStiffness, say: Progress, done: float):
+               data: MeasuredStiffness, modes: tuple[str, ...], say: Progress, done: float):
     """The best pair of candidates fitted together, each needed (the pair beats either alone by
     more than the threshold); ``None`` if no pair is."""
     ranked = [eid for eid in sorted(drops, key=drops.get, reverse=True) if drops[eid] > 0][:PAIR_POOL]
     best = None
     for i, a in enumerate(ranked):
         for b in ranked[i + 1:]:
-            if b not in candidates(tried[a].model):
+            if b not in candidates(tried[a].model, modes):
                 continue
-            say(done, f"trying {EFFECTS[a].title.lower()} with {EFFECTS[b].title.lower()}")
+            say(done, f"trying {_title(a).lower()} with {_title(b).lower()}")
             joint = _fit_candidate(tried[a], b, data)
             if joint is None:
                 continue
@@ -152,9 +167,18 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
              held_out: bool = True, progress: Progress | None = None) -> Diagnosis:
     """Run the discrepancy workflow on ``data`` from ``design`` (its geometry known, its
     parameters the starting values) with the ``baseline`` branches. Returns a :class:`Diagnosis`.
+
+    Data of several modes (a `mode` column) are fitted jointly, one material for every mode,
+    each mode through its own shape factor: an effect of the rubber is one set of parameters
+    for all modes, and each step reports which modes support it; an effect of the test rig (an
+    apparent mass) is a candidate on each mode's rig separately. At the end, the joint model is
+    weighed against one material per mode: if that is much better (BIC) and the joint misfit
+    is above the noise, the diagnosis says the modes disagree.
     """
     say = progress or (lambda fraction, message: None)
     measured, data = data, data.binned(MAX_FIT_POINTS)  # dense data: the search works on bins
+    modes = tuple(np.unique(data.mode.astype(str))) if data.mode is not None else ()
+    modes = modes if len(modes) > 1 else ()
     triples = runs(data)
     say(0.0, "fitting the baseline")
     current = _fit(baseline_model(design, baseline), data, starts=BASELINE_STARTS)
@@ -163,11 +187,11 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
     accepted: list[Accepted] = []
     done = 0.1  # progress: each round of candidates takes half of what is left up to 0.8
     while True:
-        names = candidates(current.model)
+        names = candidates(current.model, modes)
         tried: dict[str, Fitted] = {}
         span = (0.8 - done) / 2
         for i, eid in enumerate(names):
-            say(done + span * i / len(names), f"step {len(accepted) + 1}: trying {EFFECTS[eid].title.lower()}")
+            say(done + span * i / len(names), f"step {len(accepted) + 1}: trying {_title(eid).lower()}")
             fitted = _fit_candidate(current, eid, data)
             if fitted is not None:
                 tried[eid] = fitted
@@ -183,7 +207,7 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
             continue
         # no single effect explains the misfit: two that act together may (their fits interact
         # through the refitted baseline, so neither alone need explain much)
-        pair = _best_pair(current, tried, drops, data, say, done)
+        pair = _best_pair(current, tried, drops, data, modes, say, done)
         if pair is None:
             break
         (first_id, second_id), joint = pair
@@ -201,6 +225,10 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
     if not accepted:
         first = current
     remaining = noise is not None and current.mean_square > NOISE_RATIO * noise
+    disagreement = {}
+    if modes:
+        say(0.82, "weighing one material for every mode against one per mode")
+        disagreement = _disagreement(current, data, measured, remaining)
 
     # the words, with the final noise estimate: each misfit described once
     sd = math.sqrt((noise or current.mean_square) / 2.0)
@@ -208,21 +236,23 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
 
     def where(fitted: Fitted) -> str:
         if id(fitted) not in words:
-            words[id(fitted)] = describe(data, fitted.stiffness, design.mode, sd)
+            words[id(fitted)] = _words(data, fitted.stiffness, design.mode, sd)
         return words[id(fitted)]
 
     steps = []
     for a in accepted:
-        effect = EFFECTS[a.effect]
+        effect = effect_of(a.effect)
         values = parameter_values(a.values_from.design)
-        names = {p.name: effect.fitting_name(p.name) for p in effect.parameters}
+        names = dict(zip((p.name for p in effect.parameters), fitting_names(a.effect)))
         params = {p: values[n] for p, n in names.items()}
         # a parameter the final profile finds undetermined has no standard error worth quoting
         errors = {p: math.nan if n in current.fit.undetermined else a.values_from.fit.standard_errors.get(n, math.nan)
                   for p, n in names.items()}
-        steps.append(Step(a.effect, effect.title, where(a.before), a.before.bic - a.after.bic,
+        rig_mode = (split_id(a.effect)[1] or design.mode) if modes and effect.rig else None
+        steps.append(Step(effect.id, effect.title, where(a.before), a.before.bic - a.after.bic,
                           explains(a.before, a.after, noise)[1], params, a.before.gap, a.after.gap, a.drops,
-                          a.evidence, errors))
+                          a.evidence, errors, rig_mode,
+                          _support(a.before, a.after, data, measured) if modes else {}))
     held = {}
     if held_out:
         say(0.85, "checking on held-out data")
@@ -239,11 +269,73 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
 
         steps = [replace(s, gap_before=on(a.before).gap, gap_after=on(a.after).gap) for s, a in zip(steps, accepted)]
         first, current = on(first), on(current)
-    return Diagnosis(measured, first, steps, current, noise, remaining, where_first, where_final, held)
+    return Diagnosis(measured, first, steps, current, noise, remaining, where_first, where_final, held,
+                     disagreement)
+
+
+def _title(effect_id: str) -> str:
+    base, mode = split_id(effect_id)
+    return effect_of(base).title + (f" on the {mode} rig" if mode else "")
+
+
+def _words(data: MeasuredStiffness, k: np.ndarray, mode: str, sd: float) -> str:
+    """Where a model and the data disagree, in plain words; mode by mode for several."""
+    if data.mode is None or len(set(data.mode)) == 1:
+        return describe(data, k, mode if data.mode is None else str(data.mode[0]), sd)
+    return " ".join(f"{m}: {describe(data.of_mode(m), k[data.mode == m], m, sd)}"
+                    for m in np.unique(data.mode.astype(str)))
+
+
+def _mode_misfit(residual: np.ndarray, rows: np.ndarray) -> float:
+    """A mode's term of the BIC's misfit, n ln(RSS/n) over its real residuals."""
+    n = 2 * int(rows.sum())
+    return n * math.log(max(float(np.sum(np.abs(residual[rows]) ** 2)) / n, PRECISION**2))
+
+
+def _support(before: Fitted, after: Fitted, data: MeasuredStiffness, measured: MeasuredStiffness) -> dict:
+    """Each mode's share of a step's evidence: the drop of its own misfit term n ln(RSS/n)
+    (the BIC drop's data part) and its gap before and after, over every measured point. A mode
+    *supports* the step when its drop exceeds :data:`BIC_THRESHOLD`, is *against* it when its
+    misfit grows by as much, and is *neutral* otherwise (its data do not see the effect)."""
+    gaps = [gaps_by_mode(model_stiffness(f.design, measured), measured) for f in (before, after)]
+    out = {}
+    for m in np.unique(data.mode.astype(str)):
+        rows = data.mode == m
+        drop = _mode_misfit(before.residual, rows) - _mode_misfit(after.residual, rows)
+        verdict = "supports" if drop > BIC_THRESHOLD else "against" if drop < -BIC_THRESHOLD else "neutral"
+        out[m] = {"bic_drop": drop, "verdict": verdict, "gap_before": gaps[0][m], "gap_after": gaps[1][m]}
+    return out
+
+
+def _disagreement(current: Fitted, data: MeasuredStiffness, measured: MeasuredStiffness, remaining: bool) -> dict:
+    """One material for every mode (``current``, fitted jointly) weighed against one per mode:
+    the final model refitted to each mode's data alone, its parameters that act there free.
+    The modes *disagree* when the BIC drops by more than :data:`BIC_THRESHOLD` for the extra
+    parameters and the joint misfit is above the noise. Empty if a mode cannot be fitted alone
+    (too few points for its parameters)."""
+    rss, count, alone, values = 0.0, 0, {}, {}
+    for m in np.unique(data.mode.astype(str)):
+        model = current.model.alone(m)
+        part = data.of_mode(m)
+        try:
+            fit = fit_global(model.design, measured.of_mode(m), free=model.acting, initial=[{}], intervals=False)
+        except (ValueError, ArithmeticError, ConvergenceError):
+            return {}
+        r = relative_residual(model_stiffness(fit.design, part), part.stiffness) * part.weight
+        rss += float(np.sum(np.abs(r) ** 2))
+        count += len(model.acting)
+        fitted = parameter_values(fit.design)
+        alone[m], values[m] = fit.gap, {n: fitted[n] for n in model.acting}
+    n = 2 * len(data)
+    separate = n * math.log(max(rss / n, PRECISION**2)) + count * math.log(n)
+    drop = current.bic - separate
+    joint = gaps_by_mode(model_stiffness(current.design, measured), measured)
+    return {"disagree": bool(remaining and drop > BIC_THRESHOLD), "bic_drop": drop,
+            "gap_joint_by_mode": joint, "gap_alone_by_mode": alone, "parameters_alone": values}
 
 
 def _on(data: MeasuredStiffness, fitted: Fitted) -> Fitted:
     """``fitted`` (fitted to binned data) evaluated at every point of ``data``."""
-    k = stiffness_points(fitted.design, data.frequency_hz, data.amplitude)
+    k = model_stiffness(fitted.design, data)
     fit = replace(fitted.fit, gap=gap(k, data.stiffness), points=len(data))
     return Fitted(fitted.model, fit, k, relative_residual(k, data.stiffness), fitted.bic)

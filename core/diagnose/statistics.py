@@ -28,11 +28,14 @@ def runs(data: MeasuredStiffness):
     """Index triples (i, j, k) of neighbours along ln f at one amplitude and along ln amplitude
     at one frequency, with their log coordinates. Data on no such lines (scattered points) fall
     back on each point's two nearest neighbours in (ln f, ln amplitude), scaled to their ranges,
-    weighted equally."""
+    weighted equally. Data of several modes: runs within each mode."""
     lf, la = np.log(data.frequency_hz), np.log(data.amplitude)
+    # a run never crosses from one mode's rows to another's
+    _, mode = (np.zeros(lf.size), np.zeros(lf.size, dtype=int)) if data.mode is None else \
+        np.unique(data.mode.astype(str), return_inverse=True)
     triples = []
     for along, across in ((lf, la), (la, lf)):
-        keys = np.round(across, 9)
+        keys = np.round(across, 9) + 1e4 * mode  # ln values lie within ±1e3
         for key in np.unique(keys):
             idx = np.flatnonzero(keys == key)
             idx = idx[np.argsort(along[idx], kind="stable")]
@@ -42,7 +45,7 @@ def runs(data: MeasuredStiffness):
                     triples.append((idx[n - 1], idx[n], idx[n + 1], x[n - 1], x[n], x[n + 1]))
     if triples or lf.size < 3:
         return triples
-    pts = np.column_stack([(v - v.min()) / (np.ptp(v) or 1.0) for v in (lf, la)])
+    pts = np.column_stack([*((v - v.min()) / (np.ptp(v) or 1.0) for v in (lf, la)), 1e3 * mode])
     dist = np.linalg.norm(pts[:, None, :] - pts[None, :, :], axis=-1)
     np.fill_diagonal(dist, np.inf)
     near = np.argsort(dist, axis=1)[:, :2]
