@@ -13,8 +13,8 @@ import time
 import numpy as np
 
 from core import PAPER_B, TABLE_1
-from core.diagnose import diagnose
 from core.data import MeasuredStiffness, combined
+from core.diagnose import diagnose
 from core.synthetic import synthetic_stiffness
 
 TARGET_S = 5.0

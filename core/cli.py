@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import json
 import math
 import re
 import sys
 import time
 import warnings
 from contextlib import contextmanager
+from pathlib import Path
 
 import numpy as np
 
@@ -107,6 +109,9 @@ def build_parser() -> argparse.ArgumentParser:
         default="analytic",
         help="analytic steady state (default, fast) or the thesis' time-domain simulation",
     )
+    st.add_argument("--tolerance", metavar="TOLERANCES.json",
+                    help="add percentile columns of |K| and the loss factor under these tolerances "
+                         "(a Monte Carlo with a stated seed; docs/files.md)")
     st.add_argument("-o", dest="output", metavar="OUT.csv", help="write here, not to stdout")
 
     lp = sub.add_parser(
@@ -187,6 +192,17 @@ def build_parser() -> argparse.ArgumentParser:
     _grid_arguments(ex, "amplitudes in the design's mode, m or rad")
     ex.add_argument("--format", required=True, choices=("table", "nastran", "adams"), help="the file to write")
     ex.add_argument("-o", dest="output", metavar="OUT", help="write here, not to stdout")
+
+    dz = sub.add_parser(
+        "design",
+        help="geometries (and compounds within ranges) that meet target stiffnesses",
+        description="Searches a, b, L (and the material parameters the file frees) for the designs nearest the "
+        "file's starting design that meet its targets on |K|, the loss factor or the ratio of two directions, "
+        "within its limits; or says why they cannot be met (docs/files.md).",
+    )
+    dz.add_argument("targets", metavar="TARGETS.json", help="targets file (docs/files.md)")
+    dz.add_argument("-o", dest="output", metavar="DESIGNS.json",
+                    help="write the report here (the statement goes to stdout), not to stdout")
 
     return parser
 
@@ -269,7 +285,50 @@ def _cmd_stiffness(args) -> None:
                          f"point-layers for the {args.route} route; ask for fewer points or slices"
                          + (" (or the analytic route)" if args.route == "time-domain" else ""))
     result = stiffness(design, freqs, args.amp, slices=slices, route=args.route)
-    _write_csv(_finite(result.table()), args.output)
+    table = result.table()
+    if args.tolerance:
+        from .tolerance import band, band_columns
+
+        tolerances = _read_tolerances(args.tolerance, args.design)
+        if work * tolerances.samples > limit:
+            raise InputError(f"bushing stiffness: {tolerances.samples} samples × {work} point-layers is more than "
+                             f"{limit} for the {args.route} route; ask for fewer samples or points")
+        table.update(band_columns(band(design, freqs[None, :], np.asarray(args.amp)[:, None], tolerances,
+                                       slices=slices, route=args.route)))
+    _write_csv(_finite(table), args.output)
+
+
+def _read_tolerances(path: str, design_path: str):
+    """The tolerance file, with the design file's fit report when it asks for the fit's covariance."""
+    from .tolerance import MAX_FILE_BYTES, loads_tolerances
+
+    text = _small_text(path, "tolerance", MAX_FILE_BYTES)
+    try:
+        report = json.loads(Path(design_path).read_text(encoding="utf-8-sig")).get("fit")
+    except (OSError, ValueError, AttributeError):
+        report = None  # read_design has already accepted the file: a fit report is just absent
+    return loads_tolerances(text, report)
+
+
+def _small_text(path: str, what: str, limit: int) -> str:
+    """A JSON input file's text, refused beyond ``limit`` bytes, unreadable or not UTF-8."""
+    try:
+        if Path(path).stat().st_size > limit:
+            raise InputError(f"bushing: the {what} file {path!r} is larger than {limit} bytes")
+        return Path(path).read_text(encoding="utf-8-sig")
+    except OSError as exc:
+        raise InputError(f"bushing: cannot read the {what} file {path!r}: {exc.strerror}") from None
+    except UnicodeDecodeError:
+        raise InputError(f"bushing: the {what} file {path!r} is not UTF-8 text") from None
+
+
+def _cmd_design(args) -> None:
+    from .target import MAX_FILE_BYTES, loads_problem, solve
+
+    found = solve(loads_problem(_small_text(args.targets, "targets", MAX_FILE_BYTES)))
+    _write_text(found.to_json(), args.output)
+    if args.output:
+        sys.stdout.write(found.statement + "\n")
 
 
 def _cmd_loop(args) -> None:
@@ -407,7 +466,7 @@ def _cmd_export(args) -> None:
 
 
 COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop, "fit": _cmd_fit, "diagnose": _cmd_diagnose,
-            "card": _cmd_card, "export": _cmd_export}
+            "card": _cmd_card, "export": _cmd_export, "design": _cmd_design}
 
 
 def main(argv: list[str] | None = None, parser: argparse.ArgumentParser | None = None,

@@ -1,0 +1,463 @@
+"""Designs found from target stiffnesses: which a, b, L (and, within given ranges, which
+compound) meet targets on |K|, the loss factor or the ratio of two directions, within limits.
+
+The search works in logarithms: the inner radius a, the rubber's thickness t = b − a (so b > a
+always) and the length L, and the free material parameters. Among the designs that meet every
+target it seeks those nearest the starting design (the sum of squared log changes), by SLSQP
+(SciPy) from the start and from a seeded Latin hypercube over the limits. If none meets the
+targets, the design that misses them least (least squares on the misses, in logarithms) is
+reported with the targets it misses and the limits that bind there.
+
+A target is a quantity at an operating point (mode, frequency, amplitude): ``magnitude`` |K|,
+``loss_factor`` η, or for a ``ratio`` of two modes |K₁|/|K₂|. Its value is a number (met within
+± ``tolerance``, relative) or a range ``{"min": …, "max": …}``. ``docs/files.md`` gives the file.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.optimize import least_squares, minimize
+
+from .bushing import MAX_STRAIN, UNITS, stiffness_points, strain_factor
+from .data import loss_factor
+from .design import MODES, SIZE_RANGE, Design, DesignError, design_from_dict
+from .fit import PARAMETERS as MATERIAL_PARAMETERS
+from .fit import parameter
+
+QUANTITIES = ("magnitude", "loss_factor")
+GEOMETRY_LIMITS = ("inner_radius", "outer_radius", "length", "thickness")
+DEFAULT_LIMITS = {"inner_radius": (1e-3, 1.0), "outer_radius": (2e-3, 1.0), "length": (1e-3, 1.0),
+                  "thickness": (1e-3, 1.0)}
+TOLERANCE = 0.01  # a numeric target is met within ±1 % unless the file says otherwise
+MAX_TARGETS, MAX_SOLUTIONS, STARTS = 20, 10, 12
+FREQUENCY_RANGE = (1e-4, 1e5)
+FEASIBLE = 1e-6  # a constraint counts as met down to this (in logarithms)
+TIME_LIMIT_S = 20.0
+MAX_FILE_BYTES = 1_000_000
+_FILE_KEYS = ("design", "targets", "tolerance", "limits", "free_material", "fixed", "solutions")
+
+
+class TargetError(ValueError):
+    """A targets file that cannot be used, with the reason in plain words."""
+
+
+@dataclass(frozen=True)
+class Target:
+    """One target: ``quantity`` of ``modes`` (one mode, or two for a ratio) at ``frequency_hz``
+    and ``amplitudes`` (one per mode, SI), between ``low`` and ``high`` (either may be None)."""
+
+    modes: tuple[str, ...]
+    quantity: str
+    frequency_hz: float
+    amplitudes: tuple[float, ...]
+    low: float | None
+    high: float | None
+    value: float | None = None  # the number asked, for a target given as one
+
+    @property
+    def is_ratio(self) -> bool:
+        return len(self.modes) == 2
+
+    def measure(self, design: Design) -> float:
+        k = [complex(stiffness_points(design.in_mode(m), self.frequency_hz, x)) for m, x in zip(self.modes, self.amplitudes)]
+        if self.is_ratio:
+            return abs(k[0]) / abs(k[1])
+        return abs(k[0]) if self.quantity == "magnitude" else float(loss_factor(k[0]))
+
+    def describe(self) -> str:
+        amp = " and ".join(f"{x:.4g} {UNITS[m]['amplitude']}" for m, x in zip(self.modes, self.amplitudes))
+        what = (f"|K_{self.modes[0]}|/|K_{self.modes[1]}|" if self.is_ratio else
+                f"{self.modes[0]} {'|K|' if self.quantity == 'magnitude' else 'loss factor'}")
+        unit = "" if self.is_ratio or self.quantity == "loss_factor" else f" {UNITS[self.modes[0]]['stiffness']}"
+        if self.value is not None:
+            goal = f"= {self.value:.4g}{unit}"
+        else:
+            goal = " and ".join(p for p in ((f"≥ {self.low:.4g}{unit}" if self.low is not None else ""),
+                                            (f"≤ {self.high:.4g}{unit}" if self.high is not None else "")) if p)
+        return f"{what} {goal} at {self.frequency_hz:.4g} Hz, {amp}"
+
+    def misses(self, value: float) -> float:
+        """How far ``value`` lies outside the target, relative (0 inside, or within
+        :data:`FEASIBLE` of its edge)."""
+        if self.low is not None and value < self.low * (1 - FEASIBLE):
+            return value / self.low - 1.0
+        if self.high is not None and value > self.high * (1 + FEASIBLE):
+            return value / self.high - 1.0
+        return 0.0
+
+
+@dataclass(frozen=True)
+class Problem:
+    """A start design, its targets, the limits (SI, by :data:`GEOMETRY_LIMITS`) and the
+    material parameters left free within ranges."""
+
+    start: Design
+    targets: tuple[Target, ...]
+    limits: dict[str, tuple[float, float]]
+    free_material: dict[str, tuple[float, float]] = field(default_factory=dict)
+    fixed: tuple[str, ...] = ()
+    solutions: int = 3
+
+    @property
+    def variables(self) -> tuple[str, ...]:
+        geo = tuple(n for n in ("inner_radius", "thickness", "length") if n not in self.fixed)
+        return geo + tuple(self.free_material)
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        ranges = [self.limits[n] if n in self.limits else self.free_material[n] for n in self.variables]
+        return np.log([r[0] for r in ranges]), np.log([r[1] for r in ranges])
+
+    def values(self, start: Design) -> dict[str, float]:
+        g, m = start.geometry, start.material
+        out = {"inner_radius": g.inner_radius, "thickness": g.outer_radius - g.inner_radius, "length": g.length}
+        out.update({n: getattr(m, n) for n in self.free_material})
+        return out
+
+    def design(self, z: np.ndarray) -> Design:
+        v = {**self.values(self.start), **dict(zip(self.variables, np.exp(z)))}
+        material = {n: v[n] for n in self.free_material}
+        return self.start.replace(inner_radius=v["inner_radius"], outer_radius=v["inner_radius"] + v["thickness"],
+                                  length=v["length"], **material)
+
+
+@dataclass(frozen=True)
+class Solution:
+    design: Design
+    distance: float  # sqrt(Σ (ln p − ln p₀)²) over the varied parameters
+    achieved: tuple[float, ...]
+    binding: tuple[str, ...]  # limits the solution sits on
+
+    def report(self, targets) -> dict:
+        return {"design": self.design.to_dict(), "distance": self.distance,
+                "targets": [{"target": t.describe(), "value": v, "met": t.misses(v) == 0.0, "miss": t.misses(v)}
+                            for t, v in zip(targets, self.achieved)],
+                "binding_limits": list(self.binding)}
+
+
+@dataclass(frozen=True)
+class Found:
+    """What the search found: the feasible designs nearest the start (best first), or, when
+    there are none, the closest miss and the statement why."""
+
+    problem: Problem
+    solutions: list[Solution]
+    closest: Solution | None
+    statement: str
+    seconds: float
+
+    @property
+    def feasible(self) -> bool:
+        return bool(self.solutions)
+
+    def report(self) -> dict:
+        out = {"feasible": self.feasible, "statement": self.statement,
+               "solutions": [s.report(self.problem.targets) for s in self.solutions]}
+        if self.closest is not None:
+            out["closest"] = self.closest.report(self.problem.targets)
+        return out
+
+    def to_json(self) -> str:
+        return json.dumps(self.report(), indent=2, allow_nan=False) + "\n"
+
+
+# ---- the search --------------------------------------------------------------------------------------
+
+
+class _Evaluator:
+    """The targets' log-margins of a point z (cached: SLSQP asks for the same point twice).
+    ``exact``: a target given as a number is an equality (hit it), not its tolerance band."""
+
+    def __init__(self, problem: Problem, exact: bool = False):
+        self.problem, self.exact = problem, exact
+        self.cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+
+    def _both(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        key = np.asarray(z, float).tobytes()
+        if key in self.cache:
+            return self.cache[key]
+        p = self.problem
+        ineq, eq = [], []
+        try:
+            design = p.design(z)
+            b = design.geometry.outer_radius
+            ineq += [math.log(b / p.limits["outer_radius"][0]), math.log(p.limits["outer_radius"][1] / b)]
+            for t in p.targets:
+                for m, x in zip(t.modes, t.amplitudes):
+                    ineq.append(math.log(MAX_STRAIN / (strain_factor(design.geometry, m, design.in_mode(m).shape) * x)))
+            for t in p.targets:
+                q = t.measure(design)
+                lq = math.log(q) if q > 0 else -50.0
+                if self.exact and t.value is not None:
+                    eq.append(lq - math.log(t.value))
+                    continue
+                ineq += [lq - math.log(t.low) if t.low is not None else 1.0,
+                         math.log(t.high) - lq if t.high is not None else 1.0]
+            out = np.array(ineq), np.array(eq)
+            if not (np.all(np.isfinite(out[0])) and np.all(np.isfinite(out[1]))):
+                raise ValueError("not finite")
+        except (ValueError, ArithmeticError, DesignError):
+            exact = [t for t in p.targets if self.exact and t.value is not None]
+            out = (np.full(2 + sum(len(t.modes) for t in p.targets) + 2 * (len(p.targets) - len(exact)), -10.0),
+                   np.full(len(exact), 10.0))
+        self.cache[key] = out
+        return out
+
+    def margins(self, z: np.ndarray) -> np.ndarray:
+        """g(z) ≥ 0 when met: b within its limits, the strain of each target's drive at most
+        MAX_STRAIN, ln q − ln low and ln high − ln q per target (those not exact)."""
+        return self._both(z)[0]
+
+    def equalities(self, z: np.ndarray) -> np.ndarray:
+        """h(z) = 0 when met: ln q − ln value of each exact target."""
+        return self._both(z)[1]
+
+    def met(self, z: np.ndarray) -> bool:
+        ineq, eq = self._both(z)
+        return bool(np.min(ineq, initial=1.0) >= -FEASIBLE and np.max(np.abs(eq), initial=0.0) <= FEASIBLE)
+
+
+def _starts(problem: Problem, n: int, seed: int = 0) -> list[np.ndarray]:
+    lo, hi = problem.bounds()
+    first = np.clip(np.log([problem.values(problem.start)[v] for v in problem.variables]), lo, hi)
+    rng = np.random.default_rng(seed)
+    cols = [rng.permutation((np.arange(n - 1) + rng.random(n - 1)) / (n - 1)) for _ in problem.variables]
+    return [first] + [lo + (hi - lo) * np.array([c[k] for c in cols]) for k in range(n - 1)]
+
+
+def _binding(problem: Problem, z: np.ndarray, design: Design) -> tuple[str, ...]:
+    lo, hi = problem.bounds()
+    out = []
+    for name, v, a, b in zip(problem.variables, z, lo, hi):
+        if v - a < 1e-6:
+            out.append(f"{name} ≥ {math.exp(a):.4g}")
+        if b - v < 1e-6:
+            out.append(f"{name} ≤ {math.exp(b):.4g}")
+    b, (b_lo, b_hi) = design.geometry.outer_radius, problem.limits["outer_radius"]
+    if math.log(b / b_lo) < 1e-6:
+        out.append(f"outer_radius ≥ {b_lo:.4g}")
+    if math.log(b_hi / b) < 1e-6:
+        out.append(f"outer_radius ≤ {b_hi:.4g}")
+    return tuple(out)
+
+
+def _solution(problem: Problem, z: np.ndarray) -> Solution:
+    design = problem.design(z)
+    centre = np.log([problem.values(problem.start)[v] for v in problem.variables])
+    return Solution(design, float(np.sqrt(np.sum((z - centre) ** 2))),
+                    tuple(t.measure(design) for t in problem.targets), _binding(problem, z, design))
+
+
+def solve(problem: Problem, starts: int = STARTS, seed: int = 0) -> Found:
+    """Search ``problem`` (:class:`Problem`): the feasible designs nearest the start, or the
+    closest miss with the reason."""
+    t0 = time.perf_counter()
+    lo, hi = problem.bounds()
+    centre = np.log([problem.values(problem.start)[v] for v in problem.variables])
+    points = _starts(problem, starts, seed)
+    found: list[np.ndarray] = []
+    # first hit the numbers asked exactly; only if no design can, settle for their tolerance
+    for ev in (_Evaluator(problem, exact=True), _Evaluator(problem)):
+        for z0 in points:
+            if time.perf_counter() - t0 > TIME_LIMIT_S:
+                break
+            constraints = [{"type": "ineq", "fun": ev.margins}]
+            if len(ev.equalities(z0)):
+                constraints.append({"type": "eq", "fun": ev.equalities})
+            sol = minimize(lambda z: float(np.sum((z - centre) ** 2)), z0, jac=lambda z: 2.0 * (z - centre),
+                           method="SLSQP", bounds=list(zip(lo, hi)), constraints=constraints,
+                           options={"maxiter": 200, "ftol": 1e-12})
+            z = np.clip(sol.x, lo, hi)
+            if ev.met(z) and not any(np.max(np.abs(z - f)) < 1e-3 for f in found):
+                found.append(z)
+        if found:
+            break
+    solutions = sorted((_solution(problem, z) for z in found), key=lambda s: s.distance)[:problem.solutions]
+    if solutions:
+        return Found(problem, solutions, None, _found_words(problem, solutions), time.perf_counter() - t0)
+    closest = _closest(problem, ev, points)
+    return Found(problem, [], closest, _why(problem, closest), time.perf_counter() - t0)
+
+
+def _found_words(problem: Problem, solutions: list[Solution]) -> str:
+    best = solutions[0]
+    before, after = problem.values(problem.start), problem.values(best.design)
+    changes = ", ".join(f"{n} {100 * (after[n] / before[n] - 1):+.3g} %" for n in problem.variables
+                        if abs(after[n] / before[n] - 1) > 1e-9) or "nothing"
+    count = "1 design meets" if len(solutions) == 1 else f"{len(solutions)} designs meet"
+    binding = f"; the limits that bind there: {', '.join(best.binding)}" if best.binding else ""
+    return f"{count} every target. The nearest to the start changes {changes}{binding}."
+
+
+def _closest(problem: Problem, ev: _Evaluator, points) -> Solution:
+    """The design that misses the targets least: least squares on the negative margins."""
+    lo, hi = problem.bounds()
+    best = None
+    for z0 in points[:4]:
+        try:
+            sol = least_squares(lambda z: np.minimum(ev.margins(z), 0.0), np.clip(z0, lo, hi), bounds=(lo, hi),
+                                method="trf", max_nfev=300)
+        except ValueError:
+            continue
+        if best is None or sol.cost < best.cost:
+            best = sol
+    return _solution(problem, best.x if best is not None else np.clip(points[0], lo, hi))
+
+
+def _why(problem: Problem, closest: Solution) -> str:
+    missed = [f"{t.describe()} is missed by {100 * t.misses(v):+.3g} % (it reaches {v:.4g})"
+              for t, v in zip(problem.targets, closest.achieved) if abs(t.misses(v)) > 1e-6]
+    if not missed:
+        missed = ["the drive of a target would strain the rubber beyond what it survives"]
+    if closest.binding:
+        cause = f"the limits that bind there: {', '.join(closest.binding)}"
+    else:
+        cause = "no limit binds there: the targets contradict each other"
+    return f"The targets cannot be met. At the closest design, {'; '.join(missed)}; {cause}."
+
+
+# ---- the targets file --------------------------------------------------------------------------------
+
+
+def _number(key: str, value: Any, positive: bool = True) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise TargetError(f"{key}: must be a number, got {value!r}")
+    if positive and value <= 0:
+        raise TargetError(f"{key}: must be positive, got {value!r}")
+    return float(value)
+
+
+def _range(key: str, spec: Any) -> tuple[float | None, float | None]:
+    if not isinstance(spec, Mapping) or not spec or any(k not in ("min", "max") for k in spec):
+        raise TargetError(f"{key}: give a number or an object with min and/or max")
+    low = _number(f"{key}.min", spec["min"]) if "min" in spec else None
+    high = _number(f"{key}.max", spec["max"]) if "max" in spec else None
+    if low is not None and high is not None and low > high:
+        raise TargetError(f"{key}: min {low:g} is above max {high:g}")
+    return low, high
+
+
+def _target(i: int, spec: Any, tolerance: float, start: Design) -> Target:
+    key = f"targets[{i}]"
+    if not isinstance(spec, Mapping):
+        raise TargetError(f"{key}: must be an object")
+    allowed = ("mode", "ratio", "frequency_hz", "amplitude", "amplitudes", "magnitude", "loss_factor", "tolerance")
+    unknown = [k for k in spec if k not in allowed]
+    if unknown:
+        raise TargetError(f"{key}.{unknown[0]}: unknown key (allowed: {', '.join(allowed)})")
+    if ("mode" in spec) == ("ratio" in spec):
+        raise TargetError(f"{key}: give either mode (one direction) or ratio (two)")
+    modes = [spec["mode"]] if "mode" in spec else spec["ratio"]
+    if not isinstance(modes, list) or len(modes) != (1 if "mode" in spec else 2) or any(m not in MODES for m in modes):
+        raise TargetError(f"{key}: mode is one of {', '.join(MODES)}; ratio is a list of two of them")
+    if "ratio" in spec and modes[0] == modes[1]:
+        raise TargetError(f"{key}.ratio: two different modes")
+    f = _number(f"{key}.frequency_hz", spec.get("frequency_hz"))
+    if not FREQUENCY_RANGE[0] <= f <= FREQUENCY_RANGE[1]:
+        raise TargetError(f"{key}.frequency_hz: from {FREQUENCY_RANGE[0]:g} to {FREQUENCY_RANGE[1]:g} Hz, got {f:g}")
+    if "amplitudes" in spec:
+        amps = spec["amplitudes"]
+        if not isinstance(amps, list) or len(amps) != len(modes):
+            raise TargetError(f"{key}.amplitudes: one amplitude per mode ({len(modes)})")
+        amps = [_number(f"{key}.amplitudes[{j}]", a) for j, a in enumerate(amps)]
+    else:
+        amps = [_number(f"{key}.amplitude", spec.get("amplitude"))] * len(modes)
+    if len(modes) == 2 and "amplitudes" not in spec and UNITS[modes[0]]["amplitude"] != UNITS[modes[1]]["amplitude"]:
+        raise TargetError(f"{key}: {modes[0]} and {modes[1]} are driven in different units: give amplitudes, one per mode")
+    quantities = [q for q in QUANTITIES if q in spec]
+    if len(quantities) != 1 or (len(modes) == 2 and quantities != ["magnitude"]):
+        raise TargetError(f"{key}: give one of magnitude or loss_factor (a ratio takes magnitude)")
+    quantity = quantities[0]
+    tol = _number(f"{key}.tolerance", spec["tolerance"]) if "tolerance" in spec else tolerance
+    value = spec[quantity]
+    if isinstance(value, Mapping):
+        low, high = _range(f"{key}.{quantity}", value)
+        number = None
+    else:
+        number = _number(f"{key}.{quantity}", value)
+        low, high = number * (1 - tol), number * (1 + tol)
+    for m, x in zip(modes, amps):
+        try:
+            stiffness_points(start.in_mode(m), f, x)
+        except ValueError as exc:
+            raise TargetError(f"{key}: {exc}") from None
+    return Target(tuple(modes), quantity, f, tuple(amps), low, high, number)
+
+
+def problem_from_dict(data: Any) -> Problem:
+    """The targets file's object (``docs/files.md``)."""
+    if not isinstance(data, Mapping):
+        raise TargetError("the targets file must hold a JSON object")
+    unknown = [k for k in data if k not in _FILE_KEYS]
+    if unknown:
+        raise TargetError(f"{unknown[0]}: unknown key (allowed: {', '.join(_FILE_KEYS)})")
+    if "design" not in data:
+        raise TargetError("design: missing (the starting design, a design-file object)")
+    try:
+        start = design_from_dict(data["design"])
+    except DesignError as exc:
+        raise TargetError(f"design.{exc}") from None
+    tolerance = _number("tolerance", data.get("tolerance", TOLERANCE))
+    if tolerance >= 1:
+        raise TargetError(f"tolerance: a fraction below 1, got {tolerance:g}")
+    targets = data.get("targets")
+    if not isinstance(targets, list) or not 1 <= len(targets) <= MAX_TARGETS:
+        raise TargetError(f"targets: a list of 1 to {MAX_TARGETS} targets")
+    parsed = tuple(_target(i, t, tolerance, start) for i, t in enumerate(targets))
+    limits = dict(DEFAULT_LIMITS)
+    given = data.get("limits", {})
+    if not isinstance(given, Mapping):
+        raise TargetError("limits: an object of geometry name → {min, max}")
+    for name, spec in given.items():
+        if name not in GEOMETRY_LIMITS:
+            raise TargetError(f"limits.{name}: unknown (known: {', '.join(GEOMETRY_LIMITS)})")
+        low, high = _range(f"limits.{name}", spec)
+        low = DEFAULT_LIMITS[name][0] if low is None else low
+        high = DEFAULT_LIMITS[name][1] if high is None else high
+        if not SIZE_RANGE[0] <= low < high <= SIZE_RANGE[1]:
+            raise TargetError(f"limits.{name}: min < max, both within {SIZE_RANGE[0]:g}–{SIZE_RANGE[1]:g} m")
+        limits[name] = (low, high)
+    fixed = data.get("fixed", [])
+    if not isinstance(fixed, list) or any(n not in ("inner_radius", "thickness", "length") for n in fixed):
+        raise TargetError("fixed: a list of inner_radius, thickness, length (held at the start design's)")
+    free = {}
+    spec = data.get("free_material", {})
+    if not isinstance(spec, Mapping):
+        raise TargetError("free_material: an object of material parameter → {min, max}")
+    for name, r in spec.items():
+        if name not in MATERIAL_PARAMETERS:
+            raise TargetError(f"free_material.{name}: unknown (known: {', '.join(MATERIAL_PARAMETERS)})")
+        low, high = _range(f"free_material.{name}", r)
+        p_lo, p_hi = parameter(name).bounds
+        low, high = max(low or p_lo, p_lo, 1e-30), min(high or p_hi, p_hi)
+        if name == "fractional_order":
+            high = min(high, 1.0)
+        if not low < high:
+            raise TargetError(f"free_material.{name}: an empty range")
+        free[name] = (low, high)
+    n = data.get("solutions", 3)
+    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_SOLUTIONS:
+        raise TargetError(f"solutions: a whole number from 1 to {MAX_SOLUTIONS}")
+    # the fixed variables must lie within their limits
+    values = Problem(start, parsed, limits, free, tuple(fixed)).values(start)
+    for name in fixed:
+        lo, hi = limits[name]
+        if not lo <= values[name] <= hi:
+            raise TargetError(f"fixed: {name} of the start design ({values[name]:.4g} m) is outside its limits")
+    return Problem(start, parsed, limits, free, tuple(fixed), n)
+
+
+def loads_problem(text: str | bytes) -> Problem:
+    if len(text) > MAX_FILE_BYTES:
+        raise TargetError(f"the targets file is larger than {MAX_FILE_BYTES // 1_000_000} MB")
+    try:
+        data = json.loads(text)
+    except (ValueError, RecursionError) as exc:
+        raise TargetError(f"the targets file is not JSON: {exc}") from None
+    return problem_from_dict(data)

@@ -1,0 +1,334 @@
+"""Tolerance bands: how far |K| and the loss factor spread when the geometry and the compound
+vary within their tolerances, or within the uncertainty of a fit.
+
+A band is a Monte Carlo: ``samples`` designs drawn with a stated ``seed`` (NumPy's default
+generator), each computed exactly (:func:`core.bushing.stiffness_points`); the band's
+percentiles of |K| and η at every point are those of the samples. The draws:
+
+* a parameter with a tolerance ±h (relative, as a fraction of its value, or absolute in SI units)
+  is drawn ``uniform`` over [p − h, p + h], or ``normal`` with h = 3σ, truncated at ±h (no part
+  lies outside its tolerance); the parameters are independent;
+* with a fit's covariance (:class:`FitCovariance`), the material parameters the fit determined
+  are drawn jointly normal in the fit's own coordinates (ln µ, ln m, α, ln σ_fmax, ln ε½) with the
+  fit's standard errors and correlation; α is kept within (0.001, 1].
+
+The first-order propagation is the check where the spread is small: σ² = g Σ gᵀ with g the
+derivatives of |K| (or η) from :func:`core.sensitivity.log_derivatives` and Σ the draws'
+covariance.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy import stats
+
+from .bushing import stiffness_points
+from .data import loss_factor
+from .design import Design, DesignError
+from .fit import FitResult, parameter
+from .sensitivity import SENSITIVITY_PARAMETERS, log_derivatives, value_of
+
+DISTRIBUTIONS = ("uniform", "normal")
+SAMPLES = 500  # the default sample count
+SAMPLE_RANGE = (10, 5000)
+PERCENTILES = (5.0, 50.0, 95.0)
+MAX_RELATIVE = 0.9  # a tolerance of ±90 % or more is no tolerance
+MAX_EVALUATIONS = 20_000_000  # samples × points of one band
+MAX_FILE_BYTES = 100_000
+_TRUNCATED = stats.truncnorm(-3.0, 3.0)
+_UNIT_STD = {"uniform": 1.0 / math.sqrt(3.0), "normal": float(_TRUNCATED.std()) / 3.0}  # of u in [−1, 1]
+_FIT_KEYS = ("standard_errors", "correlation")
+_PERCENT = re.compile(r"^\s*([0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?\s*%\s*$")
+
+
+class ToleranceError(ValueError):
+    """A tolerance specification that cannot be used, with the reason in plain words."""
+
+
+@dataclass(frozen=True)
+class FitCovariance:
+    """A fit's uncertainty of the material: standard errors (natural units) and the correlation
+    of the fitted (log) parameters, as :class:`core.fit.FitResult` reports them."""
+
+    standard_errors: dict[str, float]
+    correlation: dict[str, dict[str, float]]
+
+    @classmethod
+    def of(cls, result: FitResult) -> FitCovariance:
+        return cls(dict(result.report()["standard_errors"]), result.report()["correlation"])
+
+    @classmethod
+    def from_report(cls, report: Any) -> FitCovariance:
+        """From the ``fit`` object of a fitted design file."""
+        if not isinstance(report, Mapping) or any(not isinstance(report.get(k), Mapping) for k in _FIT_KEYS):
+            raise ToleranceError("fit_covariance: the design file has no fit report (standard_errors and "
+                                 "correlation); give the output of `bushing fit`")
+        return cls(dict(report["standard_errors"]), {k: dict(v) for k, v in report["correlation"].items()})
+
+    def matrix(self, design: Design) -> tuple[tuple[str, ...], np.ndarray]:
+        """The material parameters and their covariance in the fit's coordinates."""
+        names = tuple(n for n in self.standard_errors if n in SENSITIVITY_PARAMETERS)
+        vague = [n for n in names if not _finite(self.standard_errors[n])]
+        if vague:
+            raise ToleranceError(f"fit_covariance: the fit does not determine {', '.join(vague)} (no standard error): "
+                                 "its covariance cannot make a band; give a tolerance for it instead")
+        if not names:
+            raise ToleranceError("fit_covariance: the fit report holds no material parameter")
+        sd = np.array([self.standard_errors[n] / (value_of(design, n) if parameter(n).log else 1.0) for n in names])
+        try:
+            corr = np.array([[float(self.correlation[a][b]) for b in names] for a in names])
+        except (KeyError, TypeError, ValueError):
+            raise ToleranceError("fit_covariance: the fit's correlation does not cover its parameters") from None
+        if not np.all(np.isfinite(corr)):
+            raise ToleranceError("fit_covariance: the fit's correlation is not defined (a degenerate fit)")
+        return names, corr * np.outer(sd, sd)
+
+
+def _finite(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Tolerances of a design's parameters: ``relative`` (a fraction of the value) or
+    ``absolute`` (SI units) half-widths by parameter name (:data:`SENSITIVITY_PARAMETERS`), the
+    ``distribution`` of the draws, their number and seed, the band's ``percentiles``, and
+    optionally a fit's ``covariance`` for the material."""
+
+    relative: dict[str, float] = field(default_factory=dict)
+    absolute: dict[str, float] = field(default_factory=dict)
+    distribution: str = "uniform"
+    samples: int = SAMPLES
+    seed: int = 0
+    percentiles: tuple[float, ...] = PERCENTILES
+    covariance: FitCovariance | None = None
+
+    def __post_init__(self):
+        for kind, values in (("relative", self.relative), ("absolute", self.absolute)):
+            for name, h in values.items():
+                if name not in SENSITIVITY_PARAMETERS:
+                    raise ToleranceError(f"tolerances.{name}: unknown parameter (known: {', '.join(SENSITIVITY_PARAMETERS)})")
+                if not _finite(h) or h < 0:
+                    raise ToleranceError(f"tolerances.{name}: must be a number ≥ 0, got {h!r}")
+                if kind == "relative" and h >= MAX_RELATIVE:
+                    raise ToleranceError(f"tolerances.{name}: ±{100 * h:g} % is not a tolerance (at most "
+                                         f"{100 * MAX_RELATIVE:g} %)")
+        both = set(self.relative) & set(self.absolute)
+        if both:
+            raise ToleranceError(f"tolerances.{min(both)}: given twice (relative and absolute)")
+        if self.distribution not in DISTRIBUTIONS:
+            raise ToleranceError(f"distribution: must be one of {', '.join(DISTRIBUTIONS)}, got {self.distribution!r}")
+        if isinstance(self.samples, bool) or not isinstance(self.samples, int) or \
+                not SAMPLE_RANGE[0] <= self.samples <= SAMPLE_RANGE[1]:
+            raise ToleranceError(f"samples: a whole number from {SAMPLE_RANGE[0]} to {SAMPLE_RANGE[1]}, got {self.samples!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or not 0 <= self.seed < 2**63:
+            raise ToleranceError(f"seed: a whole number from 0 to 2^63 − 1, got {self.seed!r}")
+        if not self.percentiles or any(not _finite(q) or not 0 <= q <= 100 for q in self.percentiles) or \
+                len(self.percentiles) > 9:
+            raise ToleranceError(f"percentiles: one to nine numbers from 0 to 100, got {list(self.percentiles)!r}")
+
+    @property
+    def varied(self) -> bool:
+        return self.covariance is not None or any(h > 0 for h in (*self.relative.values(), *self.absolute.values()))
+
+    def half_widths(self, design: Design) -> dict[str, float]:
+        """Every toleranced parameter's half-width in SI units (zero tolerances left out)."""
+        out = {n: h * value_of(design, n) for n, h in self.relative.items()}
+        out.update(self.absolute)
+        return {n: h for n, h in out.items() if h > 0}
+
+    def check(self, design: Design) -> None:
+        """Refuse tolerances that take a part outside what is a bushing (b ≤ a, a size or modulus
+        ≤ 0, α > 1), naming the parameter."""
+        h = self.half_widths(design)
+        if self.covariance is not None:
+            names, _ = self.covariance.matrix(design)
+            twice = sorted(set(names) & set(h))
+            if twice:
+                raise ToleranceError(f"tolerances.{twice[0]}: given twice (a tolerance and the fit's covariance)")
+        a_high = design.geometry.inner_radius + h.get("inner_radius", 0.0)
+        b_low = design.geometry.outer_radius - h.get("outer_radius", 0.0)
+        if a_high >= b_low:
+            raise ToleranceError(f"tolerances: a may reach {a_high:.4g} m and b fall to {b_low:.4g} m: "
+                                 "some parts would have no rubber (b ≤ a)")
+        for name, width in h.items():
+            low, high = value_of(design, name) - width, value_of(design, name) + width
+            try:
+                design.replace(**{name: low})
+                design.replace(**{name: high})
+            except DesignError as exc:
+                raise ToleranceError(f"tolerances.{name}: ±{width:.4g} takes it outside its range ({exc.rule})") from None
+
+    def draws(self, design: Design) -> list[dict[str, float]]:
+        """The sampled parameter values (only those that vary), one mapping per sample."""
+        self.check(design)
+        rng = np.random.default_rng(self.seed)
+        n = self.samples
+        out: dict[str, np.ndarray] = {}
+        for name, width in sorted(self.half_widths(design).items()):
+            u = rng.uniform(-1.0, 1.0, n) if self.distribution == "uniform" else \
+                _TRUNCATED.rvs(n, random_state=rng) / 3.0
+            out[name] = value_of(design, name) + width * u
+        if self.covariance is not None:
+            names, cov = self.covariance.matrix(design)
+            centre = np.array([math.log(value_of(design, p)) if parameter(p).log else value_of(design, p) for p in names])
+            theta = rng.multivariate_normal(centre, cov, n, method="eigh")
+            for j, name in enumerate(names):
+                lo, hi = parameter(name).bounds
+                out[name] = np.exp(theta[:, j]) if parameter(name).log else np.clip(theta[:, j], max(lo, 1e-3), hi)
+        return [{name: float(v[i]) for name, v in out.items()} for i in range(n)]
+
+    def covariance_of_draws(self, design: Design) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
+        """The names, the covariance of the draws in ln p (for first-order propagation), and the
+        scale that takes a fit's coordinate θ to ln p (1 for log-fitted, 1/p for α)."""
+        names, sd = [], []
+        for name, width in sorted(self.half_widths(design).items()):
+            names.append(name)
+            sd.append(width * _UNIT_STD[self.distribution] / value_of(design, name))
+        blocks = [np.diag(np.square(sd))]
+        if self.covariance is not None:
+            fit_names, cov = self.covariance.matrix(design)
+            to_log = np.array([1.0 if parameter(n).log else 1.0 / value_of(design, n) for n in fit_names])
+            names += list(fit_names)
+            blocks.append(cov * np.outer(to_log, to_log))
+        size = sum(b.shape[0] for b in blocks)
+        full, at = np.zeros((size, size)), 0
+        for b in blocks:
+            full[at:at + b.shape[0], at:at + b.shape[0]] = b
+            at += b.shape[0]
+        return tuple(names), full, to_log if self.covariance is not None else np.ones(0)
+
+
+@dataclass(frozen=True)
+class Band:
+    """A tolerance band on a grid: the nominal design's |K| and η, the samples' percentiles of
+    both (one array per percentile), their standard deviations, and the first-order standard
+    deviations for the check."""
+
+    percentiles: tuple[float, ...]
+    magnitude: dict[float, np.ndarray]
+    loss_factor: dict[float, np.ndarray]
+    nominal_magnitude: np.ndarray
+    nominal_loss_factor: np.ndarray
+    std_magnitude: np.ndarray
+    std_loss_factor: np.ndarray
+    first_order_magnitude: np.ndarray
+    first_order_loss_factor: np.ndarray
+    samples: int
+    seed: int
+    distribution: str
+
+
+def band(design: Design, frequency_hz, amplitude, tolerances: Tolerances, **kwargs) -> Band:
+    """The band of ``design`` over the points (``frequency_hz``, ``amplitude`` broadcast) under
+    ``tolerances``. ``kwargs`` go to :func:`core.bushing.stiffness_points` (slices, route).
+    Raises :class:`ToleranceError` for tolerances that cannot be used or a band too large."""
+    f, x = np.asarray(frequency_hz, float), np.asarray(amplitude, float)
+    shape = np.broadcast_shapes(f.shape, x.shape)
+    points = int(np.prod(shape))
+    if tolerances.samples * points > MAX_EVALUATIONS:
+        raise ToleranceError(f"{tolerances.samples} samples × {points} points is more than {MAX_EVALUATIONS:.3g} "
+                             "evaluations: use fewer samples or a coarser grid")
+    nominal = np.broadcast_to(stiffness_points(design, f, x, **kwargs), shape)
+    k = np.empty((tolerances.samples, *shape), dtype=complex)
+    for i, values in enumerate(tolerances.draws(design)):
+        try:
+            k[i] = stiffness_points(design.replace(**values), f, x, **kwargs)
+        except (ValueError, ArithmeticError) as exc:
+            raise ToleranceError(f"sample {i + 1}: within these tolerances the bushing leaves what the model "
+                                 f"computes: {exc}") from None
+    magnitude, eta = np.abs(k), loss_factor(k)
+    q = tolerances.percentiles
+    mq, eq = np.percentile(magnitude, q, axis=0), np.percentile(eta, q, axis=0)
+    first = first_order(design, f, x, tolerances, **kwargs)
+    return Band(tuple(q), dict(zip(q, mq)), dict(zip(q, eq)), np.abs(nominal), loss_factor(nominal),
+                magnitude.std(axis=0), eta.std(axis=0), first[0], first[1], tolerances.samples, tolerances.seed,
+                tolerances.distribution)
+
+
+def first_order(design: Design, frequency_hz, amplitude, tolerances: Tolerances, **kwargs):
+    """The standard deviations of |K| and η by first-order propagation, σ² = g Σ gᵀ (g the
+    derivatives in ln p, Σ the draws' covariance in ln p)."""
+    names, cov, _ = tolerances.covariance_of_draws(design)
+    shape = np.broadcast_shapes(np.shape(frequency_hz), np.shape(amplitude))
+    if not names:
+        return np.zeros(shape), np.zeros(shape)
+    d = log_derivatives(design, frequency_hz, amplitude, names, **kwargs)
+    out = []
+    for j in (0, 1):
+        g = np.stack([np.broadcast_to(d[n][j], shape) for n in names], axis=-1)
+        out.append(np.sqrt(np.maximum(np.einsum("...i,ij,...j->...", g, cov, g), 0.0)))
+    return out[0], out[1]
+
+
+# ---- the tolerance file ------------------------------------------------------------------------
+
+_FILE_KEYS = ("tolerances", "distribution", "samples", "seed", "percentiles", "fit_covariance")
+
+
+def _spread(name: str, value: Any) -> tuple[str, float]:
+    """"10%" → relative 0.1; a number → absolute (SI)."""
+    if isinstance(value, str):
+        m = _PERCENT.match(value)
+        if not m:
+            raise ToleranceError(f"tolerances.{name}: give a percentage such as \"10%\" or a number in SI units, "
+                                 f"got {value!r}")
+        return "relative", float(value.strip().rstrip("%")) / 100.0
+    if not _finite(value):
+        raise ToleranceError(f"tolerances.{name}: give a percentage such as \"10%\" or a number in SI units, got {value!r}")
+    return "absolute", float(value)
+
+
+def tolerances_from_dict(data: Any, fit_report: Any = None) -> Tolerances:
+    """The tolerance file's object (``docs/files.md``); ``fit_report`` the design file's ``fit``
+    object, used when ``fit_covariance`` is true."""
+    if not isinstance(data, Mapping):
+        raise ToleranceError("the tolerance file must hold a JSON object")
+    unknown = [k for k in data if k not in _FILE_KEYS]
+    if unknown:
+        raise ToleranceError(f"{unknown[0]}: unknown key (allowed: {', '.join(_FILE_KEYS)})")
+    spreads = data.get("tolerances", {})
+    if not isinstance(spreads, Mapping):
+        raise ToleranceError("tolerances: must be an object of parameter → tolerance")
+    relative, absolute = {}, {}
+    for name, value in spreads.items():
+        kind, h = _spread(str(name), value)
+        (relative if kind == "relative" else absolute)[str(name)] = h
+    use_fit = data.get("fit_covariance", False)
+    if not isinstance(use_fit, bool):
+        raise ToleranceError(f"fit_covariance: true or false, got {use_fit!r}")
+    percentiles = data.get("percentiles", list(PERCENTILES))
+    if not isinstance(percentiles, list):
+        raise ToleranceError(f"percentiles: a list of numbers from 0 to 100, got {percentiles!r}")
+    tol = Tolerances(relative, absolute, data.get("distribution", "uniform"), data.get("samples", SAMPLES),
+                     data.get("seed", 0), tuple(percentiles),
+                     FitCovariance.from_report(fit_report) if use_fit else None)
+    if not tol.varied:
+        raise ToleranceError("tolerances: nothing varies (give at least one tolerance above 0, or fit_covariance)")
+    return tol
+
+
+def loads_tolerances(text: str | bytes, fit_report: Any = None) -> Tolerances:
+    if len(text) > MAX_FILE_BYTES:
+        raise ToleranceError(f"the tolerance file is larger than {MAX_FILE_BYTES // 1000} kB")
+    try:
+        data = json.loads(text)
+    except (ValueError, RecursionError) as exc:
+        raise ToleranceError(f"the tolerance file is not JSON: {exc}") from None
+    return tolerances_from_dict(data, fit_report)
+
+
+def band_columns(b: Band) -> dict[str, np.ndarray]:
+    """The percentile columns ``magnitude_p5``, …, ``loss_factor_p95`` (flattened)."""
+    def tag(q: float) -> str:
+        return f"{q:g}".replace(".", "_")
+    out = {f"magnitude_p{tag(q)}": v.ravel() for q, v in b.magnitude.items()}
+    out.update({f"loss_factor_p{tag(q)}": v.ravel() for q, v in b.loss_factor.items()})
+    return out

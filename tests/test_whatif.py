@@ -1,0 +1,254 @@
+"""Supplier what-ifs: tolerance bands (against first-order propagation and the exact extremes),
+sensitivities (against finite differences and the closed forms), designs found from targets."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from app.cli import main
+from core import PAPER_B, TABLE_1, write_design
+from core.bushing import stiffness_points
+from core.data import loss_factor
+from core.fit import fit_global
+from core.sensitivity import elasticities, log_derivatives, sentence
+from core.synthetic import synthetic_stiffness
+from core.target import TargetError, problem_from_dict, solve
+from core.tolerance import FitCovariance, ToleranceError, Tolerances, band, loads_tolerances
+
+F = np.linspace(1, 100, 40)
+
+
+# ---- tolerance bands --------------------------------------------------------------------------
+
+@pytest.mark.parametrize("distribution", ["uniform", "normal"])
+def test_a_band_of_small_tolerances_has_the_first_order_spread(distribution):
+    tol = Tolerances({"shear_modulus": 0.01, "fractional_order": 0.01, "friction_strain_half": 0.01},
+                     {"length": 0.0005}, distribution, samples=2000, seed=3)
+    b = band(PAPER_B, F, 1e-4, tol)
+    # the Monte Carlo's standard deviation scatters by 1/sqrt(2N) = 1.6 % about the true one
+    np.testing.assert_allclose(b.std_magnitude, b.first_order_magnitude, rtol=0.05)
+    np.testing.assert_allclose(b.std_loss_factor, b.first_order_loss_factor, rtol=0.05)
+    np.testing.assert_allclose(b.magnitude[50.0], b.nominal_magnitude, rtol=2e-3)
+
+
+def test_a_band_of_one_parameter_lies_within_its_exact_extremes():
+    tol = Tolerances({"shear_modulus": 0.2}, samples=2000, seed=5, percentiles=(0.0, 50.0, 100.0))
+    b = band(PAPER_B, F, 1e-4, tol)
+    mu = PAPER_B.material.shear_modulus
+    low = np.abs(stiffness_points(PAPER_B.replace(shear_modulus=0.8 * mu), F, 1e-4))
+    high = np.abs(stiffness_points(PAPER_B.replace(shear_modulus=1.2 * mu), F, 1e-4))
+    assert np.all(low <= b.magnitude[0.0]) and np.all(b.magnitude[100.0] <= high)
+    span = high - low  # 2000 uniform draws come within ~1/2000 of either end
+    assert np.all(b.magnitude[0.0] - low < 0.005 * span) and np.all(high - b.magnitude[100.0] < 0.005 * span)
+    # |K| grows with µ: the extreme samples are the extreme draws, exactly
+    draws = [d["shear_modulus"] for d in tol.draws(PAPER_B)]
+    np.testing.assert_allclose(b.magnitude[0.0], np.abs(stiffness_points(PAPER_B.replace(shear_modulus=min(draws)), F, 1e-4)),
+                               rtol=1e-12)
+
+
+def test_a_band_is_fixed_by_its_seed():
+    tol = Tolerances({"shear_modulus": 0.1}, samples=50, seed=7)
+    a, b = band(PAPER_B, F, 1e-4, tol), band(PAPER_B, F, 1e-4, tol)
+    np.testing.assert_array_equal(a.magnitude[95.0], b.magnitude[95.0])
+    c = band(PAPER_B, F, 1e-4, Tolerances({"shear_modulus": 0.1}, samples=50, seed=8))
+    assert not np.array_equal(a.magnitude[95.0], c.magnitude[95.0])
+
+
+def test_a_fits_covariance_makes_a_band_that_agrees_with_first_order():
+    # 0.1 % noise: every parameter's standard error within 2 %, where first order holds (with
+    # 0.5 % noise, m's 9 % and the µ–m correlation make the second-order terms count)
+    data = synthetic_stiffness(PAPER_B, np.linspace(5, 155, 30), [1e-5, 1e-4, 3.5e-4], noise=0.001, seed=2)
+    fit = fit_global(PAPER_B, data, intervals=False)
+    tol = Tolerances(covariance=FitCovariance.of(fit), samples=2000, seed=1)
+    b = band(fit.design, F, 1e-4, tol)
+    np.testing.assert_allclose(b.std_magnitude, b.first_order_magnitude, rtol=0.05)
+    assert np.all(b.std_magnitude / b.nominal_magnitude < 0.02)  # a good fit: a narrow band
+    assert np.all(b.magnitude[5.0] < b.nominal_magnitude) and np.all(b.nominal_magnitude < b.magnitude[95.0])
+    # the same from the fitted design file's report
+    same = FitCovariance.from_report(json.loads(fit.to_json())["fit"])
+    assert same.matrix(fit.design)[0] == tol.covariance.matrix(fit.design)[0]
+
+
+@pytest.mark.parametrize("text, match", [
+    ('{"tolerances": {"outer_radius": 0.02}}', "no rubber"),
+    ('{"tolerances": {"fractional_order": "90%"}}', "not a tolerance"),
+    ('{"tolerances": {"fractional_order": 0.85, "shear_modulus": "1%"}}', "outside its range"),
+    ('{"tolerances": {"hardness": "5%"}}', "unknown parameter"),
+    ('{"tolerances": {"length": "five"}}', "give a percentage"),
+    ('{"tolerances": {"length": -0.001}}', "≥ 0"),
+    ('{"tolerances": {"length": "0%"}}', "nothing varies"),
+    ('{"tolerances": {"length": "1%"}, "samples": 1e9}', "samples"),
+    ('{"tolerances": {"length": "1%"}, "distribution": "cauchy"}', "distribution"),
+    ('{"tolerances": {"length": "1%"}, "percentiles": [5, 150]}', "percentiles"),
+    ('{"tolerances": {"length": "1%"}, "fit_covariance": true}', "no fit report"),
+    ('{"tolerances": {"length": "1%"}, "colour": 1}', "unknown key"),
+    ('[1, 2]', "JSON object"),
+    ('{"tolerances": ', "not JSON"),
+])
+def test_bad_tolerances_are_refused_with_their_reason(text, match):
+    with pytest.raises(ToleranceError, match=match):
+        band(PAPER_B, F, 1e-4, loads_tolerances(text))
+
+
+def test_an_undetermined_fit_parameter_cannot_make_a_band():
+    report = {"standard_errors": {"shear_modulus": 1e4, "friction_strain_half": None},
+              "correlation": {"shear_modulus": {"shear_modulus": 1.0}}}
+    with pytest.raises(ToleranceError, match="does not determine friction_strain_half"):
+        Tolerances(covariance=FitCovariance.from_report(report)).draws(PAPER_B)
+
+
+# ---- sensitivities ----------------------------------------------------------------------------
+
+@pytest.mark.parametrize("design, x", [(PAPER_B, 1e-4), (TABLE_1, 0.01), (PAPER_B.in_mode("torsion"), 3e-3)])
+def test_elasticities_that_the_model_fixes(design, x):
+    e = elasticities(design, 10.0, x)
+    assert e["length"]["magnitude"] == pytest.approx(1.0, abs=1e-7)  # K ∝ L, the strain free of L
+    assert e["length"]["loss_factor"] == pytest.approx(0.0, abs=1e-9)
+    # the stresses scale with µ, m and σ_fmax together
+    assert sum(e[n]["magnitude"] for n in ("shear_modulus", "fractional_coefficient", "friction_stress_max")) == \
+        pytest.approx(1.0, abs=1e-6)
+    assert sum(e[n]["loss_factor"] for n in ("shear_modulus", "fractional_coefficient", "friction_stress_max")) == \
+        pytest.approx(0.0, abs=1e-7)
+    if design.mode == "torsion":  # S ∝ scale³ and the strain at an angle is free of scale
+        assert sum(e[n]["magnitude"] for n in ("inner_radius", "outer_radius", "length")) == pytest.approx(3.0, abs=1e-6)
+
+
+def test_the_elasticity_of_a_purely_elastic_axial_bushing_to_a_is_the_closed_form():
+    elastic = PAPER_B.replace(fractional_coefficient=1e-9, friction_stress_max=1e-9)
+    e = elasticities(elastic, 10.0, 1e-4)
+    a, b = PAPER_B.geometry.inner_radius, PAPER_B.geometry.outer_radius
+    assert e["inner_radius"]["magnitude"] == pytest.approx(1 / np.log(b / a), rel=1e-7)  # S = 2πL/ln(b/a)
+    assert e["outer_radius"]["magnitude"] == pytest.approx(-1 / np.log(b / a), rel=1e-7)
+    assert e["shear_modulus"]["magnitude"] == pytest.approx(1.0, abs=1e-8)  # sinh(h)/h: STEP²/6
+
+
+def test_elasticities_match_independent_finite_differences():
+    e = elasticities(PAPER_B.in_mode("radial"), 30.0, 5e-5)
+    design = PAPER_B.in_mode("radial")
+    for name, value in (("outer_radius", design.geometry.outer_radius), ("friction_strain_half", 4e-3)):
+        k1 = stiffness_points(design.replace(**{name: value * 1.001}), 30.0, 5e-5)
+        k0 = stiffness_points(design.replace(**{name: value / 1.001}), 30.0, 5e-5)
+        h = 2 * np.log(1.001)
+        assert e[name]["magnitude"] == pytest.approx(np.log(abs(k1) / abs(k0)) / h, rel=1e-4)
+        assert e[name]["loss_factor"] == pytest.approx((loss_factor(k1) - loss_factor(k0)) / h, rel=1e-4)
+
+
+def test_alpha_at_one_takes_a_one_sided_step():
+    design = PAPER_B.replace(fractional_order=1.0)
+    d = log_derivatives(design, 10.0, 1e-4, ("fractional_order",))
+    assert np.isfinite(d["fractional_order"][0]) and np.isfinite(d["fractional_order"][1])
+
+
+def test_the_sentence_names_what_dominates():
+    text = sentence(elasticities(PAPER_B, 10.0, 1e-4))
+    assert text.startswith("|K| follows a most") and "the loss factor follows" in text
+
+
+# ---- designs from targets ---------------------------------------------------------------------
+
+def _spec(targets, **extra):
+    return {"design": PAPER_B.to_dict(), "targets": targets, **extra}
+
+
+def test_the_solver_finds_a_known_design_from_its_own_stiffnesses():
+    known = PAPER_B.replace(inner_radius=0.015, outer_radius=0.030, length=0.070)
+    targets = [{"mode": m, "frequency_hz": 10, "amplitude": x, "magnitude": abs(complex(stiffness_points(known.in_mode(m), 10.0, x)))}
+               for m, x in (("axial", 1e-4), ("torsion", 1e-2), ("radial", 1e-4))]
+    found = solve(problem_from_dict(_spec(targets, tolerance=1e-6)))
+    assert found.feasible, found.statement
+    g = found.solutions[0].design.geometry
+    np.testing.assert_allclose([g.inner_radius, g.outer_radius, g.length], [0.015, 0.030, 0.070], rtol=1e-4)
+
+
+def test_targets_are_hit_within_the_limits():
+    spec = _spec([{"mode": "axial", "frequency_hz": 10, "amplitude": 1e-4, "magnitude": 4e6},
+                  {"mode": "axial", "frequency_hz": 10, "amplitude": 1e-4, "loss_factor": {"min": 0.12}},
+                  {"ratio": ["radial", "axial"], "frequency_hz": 10, "amplitude": 1e-4, "magnitude": {"min": 6}}],
+                 limits={"outer_radius": {"max": 0.040}, "length": {"max": 0.100}})
+    found = solve(problem_from_dict(spec))
+    assert found.feasible, found.statement
+    for s in found.solutions:
+        d = s.design
+        assert d.geometry.outer_radius <= 0.040 * (1 + 1e-9) and d.geometry.length <= 0.100 * (1 + 1e-9)
+        k = complex(stiffness_points(d, 10.0, 1e-4))
+        assert abs(k) == pytest.approx(4e6, rel=1e-6)  # a number asked is hit, not only its ±1 %
+        assert loss_factor(k) >= 0.12 - 1e-9
+        assert abs(complex(stiffness_points(d.in_mode("radial"), 10.0, 1e-4))) / abs(k) >= 6 * (1 - 1e-6)
+    assert found.report()["solutions"][0]["targets"][0]["met"] is True
+
+
+def test_a_free_compound_within_its_range():
+    spec = _spec([{"mode": "axial", "frequency_hz": 10, "amplitude": 1e-4, "magnitude": 5e6}],
+                 fixed=["inner_radius", "thickness", "length"], free_material={"shear_modulus": {"min": 1e6, "max": 5e6}})
+    found = solve(problem_from_dict(spec))
+    d = found.solutions[0].design
+    assert d.geometry == PAPER_B.geometry and 1e6 <= d.material.shear_modulus <= 5e6
+    assert abs(complex(stiffness_points(d, 10.0, 1e-4))) == pytest.approx(5e6, rel=1e-6)
+
+
+def test_contradicting_targets_are_said_to_be_impossible():
+    spec = _spec([{"mode": "axial", "frequency_hz": 10, "amplitude": 1e-4, "magnitude": {"min": 5e6}},
+                  {"mode": "axial", "frequency_hz": 10, "amplitude": 1e-4, "magnitude": {"max": 4e6}}])
+    found = solve(problem_from_dict(spec))
+    assert not found.feasible and "cannot be met" in found.statement and "contradict each other" in found.statement
+
+
+def test_a_target_beyond_the_limits_names_the_limits_that_bind():
+    spec = _spec([{"mode": "axial", "frequency_hz": 10, "amplitude": 1e-4, "magnitude": 4e8}],
+                 limits={"outer_radius": {"max": 0.040}, "length": {"max": 0.100}, "thickness": {"min": 0.005}})
+    found = solve(problem_from_dict(spec))
+    assert not found.feasible
+    assert "length ≤ 0.1" in found.statement and "thickness ≥ 0.005" in found.statement
+    assert found.report()["closest"]["targets"][0]["miss"] < -0.5
+
+
+@pytest.mark.parametrize("change, match", [
+    ({"targets": []}, "a list of 1 to"),
+    ({"targets": [{"mode": "shear", "frequency_hz": 10, "amplitude": 1e-4, "magnitude": 1}]}, "mode is one of"),
+    ({"targets": [{"mode": "axial", "frequency_hz": 10, "amplitude": 1e-4}]}, "give one of magnitude"),
+    ({"targets": [{"ratio": ["radial", "torsion"], "frequency_hz": 10, "amplitude": 1e-4, "magnitude": 2}]},
+     "different units"),
+    ({"targets": [{"mode": "axial", "frequency_hz": 10, "amplitude": 5.0, "magnitude": 1e6}]}, "at most"),
+    ({"targets": [{"mode": "axial", "frequency_hz": 10, "amplitude": 1e-4, "magnitude": {"min": 5, "max": 1}}]},
+     "min 5 is above max 1"),
+    ({"limits": {"colour": {"max": 1}}}, "limits.colour: unknown"),
+    ({"free_material": {"shear_modulus": {"min": 5e6, "max": 1e6}}}, "min 5e\\+06 is above"),
+    ({"solutions": 0}, "solutions"),
+    ({"design": {"mode": "axial"}}, "design"),
+])
+def test_bad_target_files_are_refused_by_name(change, match):
+    spec = _spec([{"mode": "axial", "frequency_hz": 10, "amplitude": 1e-4, "magnitude": 4e6}])
+    spec.update(change)
+    with pytest.raises(TargetError, match=match):
+        problem_from_dict(spec)
+
+
+# ---- the command line -------------------------------------------------------------------------
+
+def test_the_command_line_adds_percentile_columns_and_finds_designs(tmp_path, capsys):
+    write_design(PAPER_B, tmp_path / "d.json")
+    (tmp_path / "t.json").write_text(json.dumps({"tolerances": {"shear_modulus": "10%", "length": 0.0005},
+                                                 "samples": 200, "seed": 4, "percentiles": [2.5, 97.5]}))
+    argv = ["stiffness", tmp_path / "d.json", "--freq", "1", "100", "5", "--amp", "1e-4", "1e-3",
+            "--tolerance", tmp_path / "t.json", "-o", tmp_path / "k.csv"]
+    assert main([str(a) for a in argv]) == 0
+    table = pd.read_csv(tmp_path / "k.csv")
+    assert list(table.columns[-4:]) == ["magnitude_p2_5", "magnitude_p97_5", "loss_factor_p2_5", "loss_factor_p97_5"]
+    expected = band(PAPER_B, np.linspace(1, 100, 5)[None, :], np.array([1e-4, 1e-3])[:, None],
+                    Tolerances({"shear_modulus": 0.1}, {"length": 0.0005}, samples=200, seed=4, percentiles=(2.5, 97.5)))
+    np.testing.assert_allclose(table["magnitude_p97_5"], expected.magnitude[97.5].ravel(), rtol=1e-9)
+    assert np.all(table["magnitude_p2_5"] < table["magnitude"]) and np.all(table["magnitude"] < table["magnitude_p97_5"])
+
+    (tmp_path / "bad.json").write_text('{"tolerances": {"outer_radius": 0.05}}')
+    with pytest.raises(SystemExit) as refused:
+        main([str(a) for a in [*argv[:-4], "--tolerance", tmp_path / "bad.json"]])
+    assert refused.value.code == 2 and "no rubber" in capsys.readouterr().err
+
+    spec = _spec([{"mode": "axial", "frequency_hz": 10, "amplitude": 1e-4, "magnitude": 4e6}])
+    (tmp_path / "targets.json").write_text(json.dumps(spec))
+    assert main(["design", str(tmp_path / "targets.json"), "-o", str(tmp_path / "designs.json")]) == 0
+    assert "meets every target" in capsys.readouterr().out
+    report = json.loads((tmp_path / "designs.json").read_text())
+    assert report["feasible"] and report["solutions"][0]["targets"][0]["value"] == pytest.approx(4e6, rel=1e-6)
