@@ -12,6 +12,7 @@ from core.shape import long_shape_factor
 
 from . import plots, units
 from .curves import card_sweeps, padded
+from .explorer import BAND_PARAMETERS
 from .live import LivePlot
 from .state import ExplorerState
 from .views import PlotView
@@ -44,7 +45,8 @@ class CardView(PlotView):
         self.plots: LivePlot | None = None
         self._update()
 
-    @param.depends("state.design", "state.errors", "state.frequency_hz", "displacement_mm", "angle_rad", watch=True)
+    @param.depends("state.design", "state.errors", "state.frequency_hz", "displacement_mm", "angle_rad",
+                   *(f"state.{n}" for n in BAND_PARAMETERS), watch=True)
     def _on_state(self):
         self.changed()
 
@@ -56,7 +58,7 @@ class CardView(PlotView):
         x, angle = self.displacement_mm * 1e-3, self.angle_rad
         try:
             rows = card(design, f, x, angle)
-            data = card_sweeps(design, f)
+            data = card_sweeps(design, f, tolerances=self.state.checked_tolerances())
         except ValueError as exc:  # outside the finite-length table, or an effect with no card
             self.table.object = f"_The card is not available for this design: {exc}_"
             return

@@ -232,13 +232,45 @@ class ExplorerData:
     reference_loop: dict | None
     measured_loop: dict | None  # measured_loop_points
     ranges: dict  # axis name → (start, end), shared by every plot of that quantity
+    bands: dict | None = None  # operating_bands, when tolerances are set
+
+
+def operating_bands(design: Design, frequency_hz: float, amplitude: float, f, x, tolerances) -> dict:
+    """Tolerance bands (:mod:`core.tolerance`) of the operating curves: against frequency ``f``
+    at the operating ``amplitude`` and against amplitude ``x`` (display units) at the operating
+    frequency, one Monte Carlo over both and the operating point itself. For each of
+    ``"frequency"`` and ``"amplitude"``, (low, high) of ``magnitude`` (display unit) and
+    ``loss_factor`` at the tolerances' first and last percentiles; ``"point"`` the operating
+    point's band, spreads and first-order spreads."""
+    from core.tolerance import band
+
+    mode = design.mode
+    a_si, x_si = units.to_si_amplitude(amplitude, mode), units.to_si_amplitude(x, mode)
+    f, n = np.asarray(f, dtype=float), len(f)
+    b = band(design, np.concatenate([f, np.full(x_si.size, frequency_hz), [frequency_hz]]),
+             np.concatenate([np.full(n, a_si), x_si, [a_si]]), tolerances)
+    low, high = min(b.percentiles), max(b.percentiles)
+    out = {}
+    for against, part in (("frequency", slice(0, n)), ("amplitude", slice(n, -1))):
+        out[against] = {"magnitude": tuple(units.display_stiffness(b.magnitude[q][part], mode) for q in (low, high)),
+                        "loss_factor": tuple(b.loss_factor[q][part] for q in (low, high))}
+    out["point"] = {"percentiles": (low, high), "samples": b.samples, "seed": b.seed, "distribution": b.distribution,
+                    "magnitude": tuple(float(units.display_stiffness(b.magnitude[q][-1], mode)) for q in (low, high)),
+                    "loss_factor": tuple(float(b.loss_factor[q][-1]) for q in (low, high)),
+                    "std_magnitude_pct": float(100 * b.std_magnitude[-1] / b.nominal_magnitude[-1]),
+                    "first_order_magnitude_pct": float(100 * b.first_order_magnitude[-1] / b.nominal_magnitude[-1]),
+                    "std_loss_factor": float(b.std_loss_factor[-1]),
+                    "first_order_loss_factor": float(b.first_order_loss_factor[-1])}
+    return out
 
 
 def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq_range=(1.0, 100.0),
                   reference: Design | None = None, measured: MeasuredStiffness | None = None,
-                  measured_loop: MeasuredLoop | None = None, n_freq: int = 120, n_amp: int = 120) -> ExplorerData:
+                  measured_loop: MeasuredLoop | None = None, n_freq: int = 120, n_amp: int = 120,
+                  tolerances=None) -> ExplorerData:
     """The explorer's curves at the operating point (``frequency_hz``, ``amplitude`` in display
-    units). A reference in another mode than ``design`` is left out."""
+    units). A reference in another mode than ``design`` is left out. With ``tolerances``
+    (:class:`core.tolerance.Tolerances`), the operating curves' bands (:func:`operating_bands`)."""
     mode = design.mode
     f = np.linspace(*freq_range, n_freq)
     x = amplitude_grid(design, n_amp)
@@ -253,9 +285,11 @@ def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq
     lp = hysteresis_loop(design, frequency_hz, amplitude)
     ref_loop = hysteresis_loop(ref, frequency_hz, amplitude) if ref is not None else None
     loop_points = measured_loop_points(measured_loop, mode)
+    bands = operating_bands(design, frequency_hz, amplitude, f, x, tolerances) if tolerances is not None else None
     ranges = {"frequency": padded([f]), "amplitude": padded([x], log=True)}
     for quantity in ("magnitude", "loss_factor"):
         parts = [s[quantity] for s in sweeps.values()] + [s[quantity] for s in operating.values()]
+        parts += [v for against in ("frequency", "amplitude") for v in bands[against][quantity]] if bands else []
         parts += [s[quantity] for s in references.values()] if references else []
         parts += [points[quantity]] if points is not None else []
         ranges[quantity] = padded(parts)
@@ -265,7 +299,7 @@ def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq
                              + ([ref_loop["force"]] if ref_loop else []) + ([loop_points["force"]] if loop_points else []))
     return ExplorerData(mode=mode, frequency_hz=frequency_hz, amplitude=amplitude, sweeps=sweeps,
                         operating=operating, references=references, measured=points, loop=lp,
-                        reference_loop=ref_loop, measured_loop=loop_points, ranges=ranges)
+                        reference_loop=ref_loop, measured_loop=loop_points, ranges=ranges, bands=bands)
 
 
 # ---- a diagnosis (core.diagnose.Diagnosis) ---------------------------------------------------------
@@ -312,11 +346,14 @@ def curve_groups(r, most: int = 5) -> list[dict]:
     return groups
 
 
-def card_sweeps(design: Design, frequency_hz: float, strains=None) -> dict:
+def card_sweeps(design: Design, frequency_hz: float, strains=None, tolerances=None) -> dict:
     """The bushing card's curves (:mod:`core.card`): for each direction, the drive amplitude in
     display units, |K| in display units and the loss factor at ``frequency_hz``, over a grid of
-    equivalent strains (the same grid for every direction, so the loss factors share an axis)."""
+    equivalent strains (the same grid for every direction, so the loss factors share an axis).
+    With ``tolerances``, each direction's band too (``magnitude_band``, ``loss_factor_band``:
+    (low, high) at the first and last percentiles), at the drives of the nominal design."""
     from core.card import CARD_MODES, card_design
+    from core.tolerance import band
 
     eps = np.geomspace(1e-5, 1e-1, 60) if strains is None else np.asarray(strains, dtype=float)
     out = {"strain": eps}
@@ -326,6 +363,11 @@ def card_sweeps(design: Design, frequency_hz: float, strains=None) -> dict:
         k = stiffness_points(d, frequency_hz, eps / c)
         out[mode] = {"amplitude": units.display_amplitude(eps / c, mode),
                      "magnitude": units.display_stiffness(np.abs(k), mode), "loss_factor": loss_factor(k)}
+        if tolerances is not None:
+            b = band(d, frequency_hz, eps / c, tolerances)
+            low, high = min(b.percentiles), max(b.percentiles)
+            out[mode]["magnitude_band"] = tuple(units.display_stiffness(b.magnitude[q], mode) for q in (low, high))
+            out[mode]["loss_factor_band"] = (b.loss_factor[low], b.loss_factor[high])
     return out
 
 

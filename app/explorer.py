@@ -13,6 +13,9 @@ from .live import LivePlot
 from .state import ExplorerState
 from .views import PlotView
 
+# what the tolerance bands depend on (app.state.ExplorerState.tolerances)
+BAND_PARAMETERS = ("tolerance_pct", "band_on", "band_distribution", "band_samples", "band_seed", "band_from_fit",
+                   "fit_result")
 GRID = (("magnitude", "frequency"), ("magnitude", "amplitude"), ("loss_factor", "frequency"),
         ("loss_factor", "amplitude"))
 
@@ -31,7 +34,8 @@ class ExplorerPlots(PlotView):
         self._update()  # built outside a held document: held, the new panes are laid out wrong
 
     @param.depends("state.design", "state.freq_min", "state.freq_max", "state.errors", "state.frequency_hz",
-                   "state.amplitude", "state.reference", "state.measured", "state.measured_loop", watch=True)
+                   "state.amplitude", "state.reference", "state.measured", "state.measured_loop",
+                   *(f"state.{n}" for n in BAND_PARAMETERS), watch=True)
     def _on_state(self):
         self.changed()
 
@@ -63,10 +67,25 @@ class ExplorerPlots(PlotView):
             f'<span class="op-summary"><b>Operating point</b>: <span class="op-point">{s.amplitude:.3g} '
             f"{s.amplitude_unit}, {s.frequency_hz:.3g} Hz</span> &nbsp;→&nbsp; |K| = "
             f"<b>{point['magnitude']:.4g} {s.stiffness_unit}</b>, loss factor <b>{point['loss_factor']:.4f}</b></span>"
+            + (f'<br><span class="band-summary">{band_words(data.bands["point"], s.stiffness_unit)}</span>'
+               if data.bands else "")
+            + (f'<br><span class="band-message" style="color:#8a5300">No tolerance band: {s.band_message}</span>'
+               if s.band_message else "")
         )
 
     def __panel__(self):
         return pn.Column(self.summary, self.loop.pane, self.grid.grid(2), sizing_mode="stretch_width")
+
+
+def band_words(p: dict, unit: str) -> str:
+    """The operating point's band in one line: its percentiles, the Monte Carlo's spread and the
+    first-order check."""
+    low, high = p["percentiles"]
+    return (f"<b>Tolerance band</b> ({low:g}–{high:g} %, {p['samples']} {p['distribution']} samples, seed {p['seed']}): "
+            f"|K| {p['magnitude'][0]:.4g}–{p['magnitude'][1]:.4g} {unit}, loss factor "
+            f"{p['loss_factor'][0]:.4f}–{p['loss_factor'][1]:.4f}. Spread (1σ) of |K| {p['std_magnitude_pct']:.2f} % "
+            f"(first order {p['first_order_magnitude_pct']:.2f} %), of the loss factor {p['std_loss_factor']:.4f} "
+            f"(first order {p['first_order_loss_factor']:.4f}).")
 
 
 def pct(value: float) -> str:

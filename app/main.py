@@ -21,6 +21,7 @@ from .slices import SlicesView
 from .state import ExplorerState
 from .teaching import TeachingView
 from .views import PlotView
+from .whatif import WhatIfView
 
 pn.extension("filedropper", throttled=False)  # the upload areas (app.uploads) are in lazy tabs
 
@@ -105,6 +106,7 @@ class App(pn.viewable.Viewer):
         ("Measured data and fit", "measured", lambda app: MeasuredView(app.state)),
         ("Find the missing effect", "diagnosis", lambda app: DiagnosisView(DiagnosisState(app.state))),
         ("Every direction", "card", lambda app: CardView(app.state)),
+        ("What-ifs", "whatif", lambda app: WhatIfView(app.state)),
     )
 
     def __init__(self, state: ExplorerState | None = None, **params):
@@ -131,6 +133,7 @@ class App(pn.viewable.Viewer):
     card = property(lambda self: self.view("card"))
     measured = property(lambda self: self.view("measured"))
     diagnosis = property(lambda self: self.view("diagnosis"))
+    whatif = property(lambda self: self.view("whatif"))
 
     def view(self, name: str):
         """The view of a lazily built tab, built (and put in its tab) on first use."""

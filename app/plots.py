@@ -193,6 +193,26 @@ def _overlay(items, title, png, *, logx=False, logy=False, legend="right", heigh
     return _styled("Overlay", list(items), **options)
 
 
+def band_area(x, low, high, xdim: hv.Dimension, ydim: hv.Dimension, label: str, color: str):
+    """A tolerance band: the area between ``low`` and ``high``."""
+    # its own label: HoloViews finds a dimension by its label, and two alike would both read the lower
+    upper = hv.Dimension(f"{ydim.name}_upper", label=f"{ydim.label} (band top)", unit=ydim.unit)
+    return _styled("Area", (np.asarray(x, dtype=float), np.asarray(low, dtype=float), np.asarray(high, dtype=float)),
+                   kdims=[xdim], vdims=[ydim, upper], label=label, color=color, fill_alpha=0.22, line_alpha=0.0,
+                   tools=["hover"])
+
+
+def band_label(percentiles) -> str:
+    low, high = percentiles
+    return f"{low:g}–{high:g} % band"
+
+
+def sensitivity_bars(bars: hv.Bars, title: str, color: str, png: str) -> hv.Bars:
+    """Sensitivities as a bar chart, largest first (:mod:`core.sensitivity`)."""
+    return bars.opts(title=title, color=color, responsive=True, height=260, framewise=True, tools=["hover"],
+                     hooks=[png_name(png)], fontsize={"title": "13px"}, xrotation=0, show_legend=False)
+
+
 def marker(x: float, dim: hv.Dimension):
     """The operating point: a dotted vertical line at ``x``."""
     return _styled("VLine", float(x), kdims=[dim, hv.Dimension("y")], color=OPERATING_COLOR,
@@ -228,13 +248,17 @@ def sweep_curves(quantity: str, against: str, sweep: dict, dims: dict, labels) -
 
 
 def sweep_overlay(quantity: str, against: str, sweep_items: list, dims: dict, *, operating: dict,
-                  at: float, reference: dict | None = None, measured: dict | None = None) -> hv.Overlay:
+                  at: float, reference: dict | None = None, measured: dict | None = None,
+                  band: tuple | None = None, band_name: str = "") -> hv.Overlay:
     """|K| or the loss factor against ``against`` ("frequency" or "amplitude"): the sweeps
-    (:func:`sweep_curves`), the curve through the operating point (``operating``, a one-row
-    sweep), a reference design's (dashed), measured points and the marker at ``at``."""
+    (:func:`sweep_curves`), the tolerance band of the operating curve (``band``: low, high), the
+    curve through the operating point (``operating``, a one-row sweep), a reference design's
+    (dashed), measured points and the marker at ``at``."""
     xdim, ydim = dims[against], dims[quantity]
     x_of = (lambda s: s["frequency_hz"]) if against == "frequency" else (lambda s: s["amplitude"])
     items = list(sweep_items)
+    if band is not None:
+        items.append(band_area(x_of(operating), *band, xdim, ydim, band_name, OPERATING_COLOR))
     if reference is not None:
         items.append(_curve(x_of(reference), reference[quantity][0], xdim, ydim, "reference", **REFERENCE_STYLE))
     items.append(_curve(x_of(operating), operating[quantity][0], xdim, ydim, "operating point",
@@ -272,7 +296,9 @@ def explorer_overlays(data: curves.ExplorerData, dims: dict | None = None, sweep
         out[(quantity, against)] = sweep_overlay(
             quantity, against, items, dims, operating=data.operating[against],
             at=data.frequency_hz if against == "frequency" else data.amplitude,
-            reference=data.references[against] if data.references else None, measured=data.measured)
+            reference=data.references[against] if data.references else None, measured=data.measured,
+            band=data.bands[against][quantity] if data.bands else None,
+            band_name=band_label(data.bands["point"]["percentiles"]) if data.bands else "")
     return out
 
 
@@ -501,8 +527,10 @@ def card_overlays(data: dict, dims: dict, at: dict) -> dict:
              "|K| along and across the axis"),
             ("rotation", ("torsion", "conical"), dims["angle"], dims["k_rotation"], "|K| turning and tilting")):
         for quantity, y_dim, name in (("magnitude", ydim, which), ("loss_factor", dims["loss"], f"{which}_loss")):
-            items = [_curve(data[m]["amplitude"], data[m][quantity], xdim, y_dim, m, color=CARD_COLORS[m],
-                            line_width=2) for m in modes]
+            items = [band_area(data[m]["amplitude"], *data[m][f"{quantity}_band"], xdim, y_dim, f"{m} band",
+                               CARD_COLORS[m]) for m in modes if f"{quantity}_band" in data[m]]
+            items += [_curve(data[m]["amplitude"], data[m][quantity], xdim, y_dim, m, color=CARD_COLORS[m],
+                             line_width=2) for m in modes]
             items.append(marker(at[which], xdim))
             label = title if quantity == "magnitude" else f"Loss factor, {title[4:]}"
             out[name] = _overlay(items, label, f"bushing-card-{name.replace('_', '-')}", logx=True, height=260)

@@ -25,7 +25,9 @@ from core.data import (
     parse_stiffness,
 )
 from core.design import SIZE_RANGE, as_dict
+from core.fit import PARAMETERS as MATERIAL_PARAMETERS
 from core.fit import FitResult, fit_global, fit_two_step, predicted, selection
+from core.tolerance import SAMPLES, FitCovariance, ToleranceError, Tolerances
 
 from . import curves, units
 from .units import FREQUENCY_BOUNDS
@@ -138,6 +140,19 @@ class ExplorerState(param.Parameterized):
                           doc="Empty: fit every row. Else mode=NAME[+NAME…] and/or amplitude=VALUE[+VALUE…] "
                           "(SI), comma-separated, e.g. mode=axial,amplitude=1e-4: the fit uses those rows and "
                           "predicts the others, with the gap of each mode and amplitude.")
+
+    # ---- what-ifs: tolerance bands ---------------------------------------------------------------
+    tolerance_pct = param.Dict(default={}, doc="Parameter (core name) → its tolerance, ± % of its value.")
+    band_on = param.Boolean(default=False, label="Show tolerance bands on the stiffness plots")
+    band_distribution = param.Selector(objects=["uniform", "normal"], default="uniform", label="Distribution",
+                                       doc="Uniform over ± the tolerance, or normal with the tolerance at 3σ "
+                                       "(truncated there).")
+    band_samples = param.Integer(default=SAMPLES, bounds=(10, 2000), label="Samples")
+    band_seed = param.Integer(default=0, bounds=(0, 2**31 - 1), label="Seed")
+    band_from_fit = param.Boolean(default=False, label="Material from the fit's covariance",
+                                  doc="Draw the five material parameters from the last fit's standard errors and "
+                                  "correlation (instead of their tolerances).")
+    band_message = param.String(default="", doc="Why no band is drawn, if one was asked for.")
 
     def __init__(self, **params):
         self._loaded = []  # the last design loaded (a file, a fit): kept while the inputs show it
@@ -434,10 +449,47 @@ class ExplorerState(param.Parameterized):
     def operating_point(self, design: Design | None = None) -> dict:
         return curves.operating_point(design or self.design, self.frequency_hz, self.amplitude)
 
+    def tolerances(self) -> Tolerances | None:
+        """The tolerances the bands are drawn with (:class:`core.tolerance.Tolerances`), None
+        when bands are off or nothing varies. Raises ToleranceError with the reason."""
+        if not self.band_on:
+            return None
+        material = set(MATERIAL_PARAMETERS) if self.band_from_fit else set()
+        relative = {n: v / 100.0 for n, v in self.tolerance_pct.items() if v and n not in material}
+        covariance = None
+        if self.band_from_fit:
+            if self.fit_result is None:
+                raise ToleranceError("no fit yet: fit measured data first (Measured data and fit), or use tolerances")
+            covariance = FitCovariance.of(self.fit_result)
+        tol = Tolerances(relative, distribution=self.band_distribution, samples=self.band_samples, seed=self.band_seed,
+                         covariance=covariance)
+        if not tol.varied:
+            raise ToleranceError("every tolerance is 0: give one (± %) to see a band")
+        tol.check(self.design)
+        return tol
+
+    def checked_tolerances(self) -> Tolerances | None:
+        """:meth:`tolerances`, or None with the reason in :attr:`band_message`."""
+        try:
+            tol = self.tolerances()
+        except ToleranceError as exc:
+            self.band_message = str(exc)
+            return None
+        self.band_message = ""
+        return tol
+
     def explorer_data(self):
         """Everything the explorer's five plots show (:func:`app.curves.explorer_data`)."""
-        return curves.explorer_data(self.design, self.frequency_hz, self.amplitude, freq_range=self.freq_range,
-                             reference=self.reference, measured=self.measured, measured_loop=self.measured_loop)
+        tolerances = self.checked_tolerances()
+        try:
+            return curves.explorer_data(self.design, self.frequency_hz, self.amplitude, freq_range=self.freq_range,
+                                        reference=self.reference, measured=self.measured,
+                                        measured_loop=self.measured_loop, tolerances=tolerances)
+        except ToleranceError as exc:  # a sample the model cannot compute: the plots without the band
+            self.band_message = str(exc)
+            return curves.explorer_data(self.design, self.frequency_hz, self.amplitude, freq_range=self.freq_range,
+                                        reference=self.reference, measured=self.measured,
+                                        measured_loop=self.measured_loop)
 
     def comparison(self) -> dict | None:
         """Current design against the pinned reference, in %, at the operating point and over

@@ -47,6 +47,11 @@ def display_amplitude(x_si, mode: str):
     return np.asarray(x_si, dtype=float) / AMPLITUDE[mode][1]
 
 
+def to_si_stiffness(k, mode: str):
+    """A stiffness in display units (kN/mm or N·m/rad) in SI (N/m or N·m/rad)."""
+    return np.asarray(k, dtype=float) * STIFFNESS[mode][1]
+
+
 def display_stiffness(k, mode: str):
     """A stiffness in SI (N/m or N·m/rad) in display units (kN/mm or N·m/rad)."""
     return np.asarray(k) / STIFFNESS[mode][1]

@@ -459,3 +459,34 @@ def test_every_direction_from_a_link(page, explorer_url):
     shown = plots(page)
     assert shown["|K| along and across the axis"]["points"] >= 2 * 60
     assert shown["Loss factor, turning and tilting"]["points"] >= 2 * 60
+
+
+def test_what_ifs_bands_sensitivities_and_a_design_from_targets(page, explorer_url):
+    """Tolerances switched on draw a band on every stiffness plot; the sensitivity bars are
+    drawn; a |K| target finds a design that the explorer takes."""
+    open_explorer(page, explorer_url)
+    page.get_by_text("What-ifs", exact=True).click()
+    page.get_by_role("button", name="Find designs").wait_for(timeout=20000)
+    wait_quiet(page)
+    shown = plots(page)
+    assert shown["|K|: % per +1 % of the parameter"]["points"] == 8
+    box = page.get_by_label("Shear modulus µ ± %")
+    box.fill("10")
+    box.press("Enter")
+    page.locator(".band-switch input[type=checkbox]").check()
+    wait_quiet(page)
+    page.get_by_text("Explorer", exact=True).click()
+    page.get_by_text("Tolerance band (5–95 %").wait_for(timeout=20000)
+    wait_quiet(page)
+    for title in ("|K| against frequency", "Loss factor against amplitude"):
+        assert "5–95 % band" in plots(page)[title]["legends"], title
+    page.get_by_text("What-ifs", exact=True).click()
+    target = page.get_by_label("|K| target")
+    target.fill("4.5")
+    target.press("Enter")
+    page.get_by_role("button", name="Find designs").click()
+    page.get_by_text("1 design meets every target").wait_for(timeout=20000)
+    page.get_by_role("button", name="Take it into the explorer").click()
+    page.get_by_text("VP 40/70120 (Paper B) (from targets)").first.wait_for(timeout=10000)
+    page.get_by_text("Explorer", exact=True).click()
+    page.get_by_text("|K| = 4.5 kN/mm").wait_for(timeout=20000)

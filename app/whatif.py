@@ -1,0 +1,277 @@
+"""The "What-ifs" tab: tolerance bands (drawn on the explorer's stiffness plots and the card),
+sensitivities at the operating point, and designs found from target stiffnesses."""
+
+from __future__ import annotations
+
+import asyncio
+import io
+import json
+import logging
+
+import holoviews as hv
+import panel as pn
+import param
+
+from core.sensitivity import SENSITIVITY_PARAMETERS, SYMBOLS, elasticities, ranked, sentence
+from core.target import Found, TargetError, problem_from_dict, solve
+
+from . import plots, units
+from .live import LivePlot
+from .state import ExplorerState
+from .views import PlotView
+
+log = logging.getLogger("bushing.app")
+
+NAMES = {"inner_radius": "Inner radius a", "outer_radius": "Outer radius b", "length": "Length L",
+         "shear_modulus": "Shear modulus µ", "fractional_coefficient": "Fractional coefficient m",
+         "fractional_order": "Fractional order α", "friction_stress_max": "Friction stress σ_fmax",
+         "friction_strain_half": "Friction strain ε½"}
+
+TOLERANCE_TEXT = """
+**Tolerance bands.** Give each parameter's tolerance (± % of its value) and switch the bands on:
+every stiffness plot of the Explorer (and the Every direction tab) shows the 5–95 % band of the
+operating curve. The band is a Monte Carlo with the stated number of samples and seed, so the
+same inputs give the same band. Beside it is the first-order spread (from the derivatives),
+which should agree where the tolerances are small. The material may instead come from the last
+fit's standard errors and correlations.
+"""
+SENSITIVITY_TEXT = """
+**Sensitivities at the operating point.** Bar length ∂ln|K|/∂ln p: a +1 % change of the parameter
+moves |K| by that many per cent. For the loss factor, ∂η/∂ln p: a +1 % change moves η by a
+hundredth of it. The bars follow the operating point.
+"""
+DESIGN_TEXT = """
+**Design from targets.** Ask for |K| (and, optionally, a least loss factor and a radial/axial
+ratio) at the operating point of the Explorer. Set the limits. The search looks for the designs
+nearest the current one that meet every target, or it says why none can. Blank fields are not
+targets. The same search runs from the command line (`bushing design TARGETS.json`); download
+the targets file to repeat it there.
+"""
+
+
+class WhatIfView(PlotView):
+    """Tolerances, sensitivities, targets."""
+
+    target_magnitude = param.Number(default=None, allow_None=True, bounds=(0, None), label="|K| target")
+    target_tolerance_pct = param.Number(default=1.0, bounds=(0.001, 50.0), label="Met within ± %")
+    loss_factor_min = param.Number(default=None, allow_None=True, bounds=(0, 10), label="Loss factor at least")
+    ratio_min = param.Number(default=None, allow_None=True, bounds=(0, None), label="Radial / axial at least")
+    b_max_mm = param.Number(default=None, allow_None=True, bounds=(0, None), label="b at most (mm)")
+    length_max_mm = param.Number(default=None, allow_None=True, bounds=(0, None), label="L at most (mm)")
+    thickness_min_mm = param.Number(default=2.0, allow_None=True, bounds=(0, None), label="Rubber b − a at least (mm)")
+    hold_inner = param.Boolean(default=True, label="Keep the inner radius (the shaft)")
+    mu_min_mpa = param.Number(default=None, allow_None=True, bounds=(0, None), label="µ from (MPa)")
+    mu_max_mpa = param.Number(default=None, allow_None=True, bounds=(0, None), label="µ to (MPa)")
+    running = param.Boolean(default=False)
+    found = param.Parameter(default=None, doc="The last search's core.target.Found.")
+    message = param.String(default="")
+
+    def __init__(self, state: ExplorerState, **params):
+        super().__init__(state, **params)
+        self.tolerance_inputs = {
+            n: pn.widgets.FloatInput(label=f"{NAMES[n]} ± %", value=state.tolerance_pct.get(n, 0.0), start=0.0,
+                                     end=89.0, step=0.5, width=170)
+            for n in SENSITIVITY_PARAMETERS}
+        for name, widget in self.tolerance_inputs.items():
+            widget.param.watch(lambda e, n=name: self._set_tolerance(n, e.new), "value")
+        s = state.param
+        self.band_controls = pn.Row(
+            pn.widgets.Checkbox.from_param(s.band_on, margin=(28, 10), width=330, css_classes=["band-switch"]),
+            pn.widgets.Select.from_param(s.band_distribution, width=120),
+            pn.widgets.IntInput.from_param(s.band_samples, width=100),
+            pn.widgets.IntInput.from_param(s.band_seed, width=100),
+            pn.widgets.Checkbox.from_param(s.band_from_fit, margin=(28, 10)),
+            sizing_mode="stretch_width")
+        self.band_status = pn.pane.HTML("", sizing_mode="stretch_width")
+        self.sentence = pn.pane.Markdown("", sizing_mode="stretch_width")
+        self.bars: LivePlot | None = None
+        self.find = pn.widgets.Button(label="Find designs", color="primary", width=160)
+        self.find.on_click(self._run)
+        self.solutions = pn.widgets.Select(label="Solution", options={}, width=420, visible=False)
+        self.use = pn.widgets.Button(label="Take it into the explorer", color="success", visible=False)
+        self.use.on_click(lambda _e: self.use_solution())
+        self.result = pn.pane.Markdown("", sizing_mode="stretch_width")
+        self.targets_file = pn.widgets.FileDownload(callback=self._targets_file, filename="bushing-targets.json",
+                                                    label="Targets file (JSON)", width=200)
+        self._on_band()
+        self._update()
+
+    # ---- tolerances ------------------------------------------------------------------------------
+
+    def _set_tolerance(self, name: str, value):
+        values = dict(self.state.tolerance_pct)
+        values[name] = float(value or 0.0)
+        self.state.tolerance_pct = {n: v for n, v in values.items() if v}
+
+    @param.depends("state.band_message", "state.band_on", "state.fit_result", "state.band_from_fit", watch=True)
+    def _on_band(self):
+        s = self.state
+        if s.band_on and s.band_message:
+            self.band_status.object = f'<span style="color:#8a5300">No band: {s.band_message}</span>'
+        elif s.band_on:
+            self.band_status.object = "Bands are drawn on the Explorer's stiffness plots and in Every direction."
+        else:
+            self.band_status.object = ""
+        if s.band_from_fit and s.fit_result is None:
+            self.band_status.object = ('<span style="color:#8a5300">No fit yet: fit measured data first '
+                                       "(Measured data and fit).</span>")
+
+    # ---- sensitivities ---------------------------------------------------------------------------
+
+    @param.depends("state.design", "state.errors", "state.frequency_hz", "state.amplitude", watch=True)
+    def _on_state(self):
+        self.changed()
+
+    def sensitivities(self) -> dict:
+        s = self.state
+        return elasticities(s.design, s.frequency_hz, float(units.to_si_amplitude(s.amplitude, s.design.mode)))
+
+    def _update(self):
+        values = self.sensitivities()
+        items = []
+        for quantity, label, color in (("magnitude", "∂ln|K| / ∂ln p", "#1f5f8b"),
+                                       ("loss_factor", "∂η / ∂ln p", "#2ca02c")):
+            order = ranked(values, quantity)
+            bars = hv.Bars([(SYMBOLS[n], v) for n, v in order], kdims=[hv.Dimension("parameter", label="Parameter")],
+                           vdims=[hv.Dimension(f"sensitivity_{quantity}", label=label)])
+            title = "|K|: % per +1 % of the parameter" if quantity == "magnitude" else \
+                "Loss factor: change per unit ln p"
+            items.append(plots.sensitivity_bars(bars, title, color, f"bushing-sensitivity-{quantity.replace('_', '-')}"))
+        if self.bars is None:
+            self.bars = LivePlot(items)
+        else:
+            self.bars.show(items)
+        s = self.state
+        self.sentence.object = (f"At {s.frequency_hz:.3g} Hz and {s.amplitude:.3g} {s.amplitude_unit}: "
+                                f"{sentence(values)}")
+
+    # ---- targets ---------------------------------------------------------------------------------
+
+    def spec(self) -> dict:
+        """The targets file (docs/files.md) of the form: targets at the explorer's operating point."""
+        s = self.state
+        design = s.design
+        mode, f = design.mode, s.frequency_hz
+        x = float(units.to_si_amplitude(s.amplitude, mode))
+        targets = []
+        if self.target_magnitude:
+            targets.append({"mode": mode, "frequency_hz": f, "amplitude": x,
+                            "magnitude": float(units.to_si_stiffness(self.target_magnitude, mode)),
+                            "tolerance": self.target_tolerance_pct / 100.0})
+        if self.loss_factor_min:
+            targets.append({"mode": mode, "frequency_hz": f, "amplitude": x, "loss_factor": {"min": self.loss_factor_min}})
+        if self.ratio_min:
+            drive = x if mode in ("axial", "radial") else 1e-4  # a translation's drive: the operating one, or 0.1 mm
+            targets.append({"ratio": ["radial", "axial"], "frequency_hz": f, "amplitude": drive,
+                            "magnitude": {"min": self.ratio_min}})
+        limits = {}
+        if self.b_max_mm:
+            limits["outer_radius"] = {"max": self.b_max_mm * 1e-3}
+        if self.length_max_mm:
+            limits["length"] = {"max": self.length_max_mm * 1e-3}
+        if self.thickness_min_mm:
+            limits["thickness"] = {"min": self.thickness_min_mm * 1e-3}
+        out = {"design": design.to_dict(), "targets": targets, "limits": limits, "solutions": 5}
+        if self.hold_inner:
+            out["fixed"] = ["inner_radius"]
+        if self.mu_min_mpa or self.mu_max_mpa:
+            out["free_material"] = {"shear_modulus": {k: v * 1e6 for k, v in (("min", self.mu_min_mpa),
+                                                                              ("max", self.mu_max_mpa)) if v}}
+        return out
+
+    def _targets_file(self):
+        return io.StringIO(json.dumps(self.spec(), indent=2) + "\n")
+
+    def compute(self) -> Found:
+        """The search (pure: safe in a worker thread)."""
+        spec = self.spec()
+        if not spec["targets"]:
+            raise TargetError("give at least one target: |K|, a least loss factor or a radial/axial ratio")
+        return solve(problem_from_dict(spec))
+
+    async def _run(self, _event):
+        if self.running:
+            return
+        self.param.update(running=True, message="")
+        self.find.loading = True
+        try:
+            found = await asyncio.to_thread(self.compute)
+        except (TargetError, ValueError) as exc:
+            self.param.update(found=None, message=str(exc))
+        except Exception as exc:  # noqa: BLE001 - never a traceback in the page
+            log.warning("design search failed: %s: %s", type(exc).__name__, exc)
+            self.param.update(found=None, message=f"The search failed ({type(exc).__name__}): {exc}")
+        else:
+            self.param.update(found=found, message="")
+        finally:
+            self.running = False
+            self.find.loading = False
+
+    def run(self):
+        """The search, on this thread (tests and scripts)."""
+        try:
+            self.param.update(found=self.compute(), message="")
+        except (TargetError, ValueError) as exc:
+            self.param.update(found=None, message=str(exc))
+
+    @param.depends("found", "message", watch=True)
+    def _show_found(self):
+        found = self.found
+        if found is None:
+            self.result.object = f"**Cannot search**: {self.message}" if self.message else ""
+            self.solutions.visible = self.use.visible = False
+            return
+        mode = found.problem.start.mode
+        lines = [f"**{found.statement}** ({found.seconds:.2f} s)"]
+        rows = found.solutions or ([found.closest] if found.closest is not None else [])
+        if rows:
+            targets = found.problem.targets
+            lines += ["", "| | a (mm) | b (mm) | L (mm) | µ (MPa) | " +
+                      " | ".join(f"target {j}" for j in range(1, len(targets) + 1)) + " |",
+                      "|---" * (5 + len(targets)) + "|"]
+            for i, sol in enumerate(rows, 1):
+                g, m = sol.design.geometry, sol.design.material
+                got = " | ".join(f"{units.display_stiffness(v, mode):.4g} {units.stiffness_unit(mode)}"
+                                 if t.quantity == "magnitude" and not t.is_ratio else f"{v:.4g}"
+                                 for t, v in zip(targets, sol.achieved))
+                name = f"{i}" if found.solutions else "closest"
+                lines.append(f"| {name} | {g.inner_radius * 1e3:.3f} | {g.outer_radius * 1e3:.3f} | "
+                             f"{g.length * 1e3:.2f} | {m.shear_modulus / 1e6:.4g} | {got} |")
+            lines += [""] + [f"Target {j}: {t.describe()} (SI units)." for j, t in enumerate(targets, 1)]
+        self.result.object = "\n".join(lines)
+        self.solutions.options = {f"{i}: a {s.design.geometry.inner_radius * 1e3:.3f}, b "
+                                  f"{s.design.geometry.outer_radius * 1e3:.3f}, L {s.design.geometry.length * 1e3:.2f} mm": i - 1
+                                  for i, s in enumerate(rows, 1)}
+        self.solutions.visible = self.use.visible = bool(rows)
+        self.use.label = "Take it into the explorer" if found.solutions else "Take the closest into the explorer"
+
+    def use_solution(self, index: int | None = None):
+        """Take a found design into the explorer (the operating point kept)."""
+        found = self.found
+        if found is None:
+            return
+        rows = found.solutions or [found.closest]
+        i = self.solutions.value if index is None else index
+        design = rows[int(i or 0)].design
+        self.state.adopt(design.replace(name=f"{self.state.design.name or 'Design'} (from targets)"))
+
+    def __panel__(self):
+        w = pn.widgets.FloatInput.from_param
+        tol_grid = pn.GridBox(*self.tolerance_inputs.values(), ncols=4, sizing_mode="stretch_width")
+        form = pn.Column(
+            pn.Row(w(self.param.target_magnitude, width=150), w(self.param.target_tolerance_pct, width=120),
+                   w(self.param.loss_factor_min, width=150), w(self.param.ratio_min, width=150)),
+            pn.Row(w(self.param.b_max_mm, width=150), w(self.param.length_max_mm, width=150),
+                   w(self.param.thickness_min_mm, width=170),
+                   pn.widgets.Checkbox.from_param(self.param.hold_inner, margin=(28, 10))),
+            pn.Row(w(self.param.mu_min_mpa, width=150), w(self.param.mu_max_mpa, width=150),
+                   pn.pane.HTML("<i>A µ range lets the compound vary too.</i>", margin=(28, 10))),
+            pn.Row(self.find, self.targets_file),
+            self.result, pn.Row(self.solutions, self.use), sizing_mode="stretch_width")
+        return pn.Column(
+            pn.pane.Markdown(TOLERANCE_TEXT, sizing_mode="stretch_width"), tol_grid, self.band_controls,
+            self.band_status,
+            pn.pane.Markdown(SENSITIVITY_TEXT, sizing_mode="stretch_width"), self.sentence, self.bars.grid(2),
+            pn.pane.Markdown(DESIGN_TEXT, sizing_mode="stretch_width"), form,
+            sizing_mode="stretch_width")
+

@@ -1,0 +1,110 @@
+"""The What-ifs tab without a browser: bands on the explorer's plots and the card against the
+core's band, the sensitivity bars against the core, the design form's search and its adoption."""
+
+import json
+
+import numpy as np
+import pytest
+
+from app.main import App
+from core import PAPER_B
+from core.bushing import stiffness_points
+from core.fit import fit_global
+from core.sensitivity import SYMBOLS, elasticities
+from core.synthetic import synthetic_stiffness
+from core.tolerance import Tolerances, band
+
+
+@pytest.fixture
+def app():
+    return App()
+
+
+def area(overlay, label):
+    el = next(e for e in overlay if e.label == label)
+    return el.dimension_values(0), el.dimension_values(1), el.dimension_values(2)
+
+
+def test_bands_on_the_explorer_are_the_cores(app):
+    v = app.whatif
+    v.tolerance_inputs["shear_modulus"].value = 10
+    v.tolerance_inputs["length"].value = 1
+    app.state.param.update(band_on=True, band_samples=200, band_seed=3)
+    app.tabs.active = 0
+    assert app.state.tolerance_pct == {"shear_modulus": 10.0, "length": 1.0}
+    f, low, high = area(app.plots.frame(("magnitude", "frequency")), "5–95 % band")
+    expected = band(PAPER_B, f, 1e-4, Tolerances({"shear_modulus": 0.1, "length": 0.01}, samples=200, seed=3))
+    # one Monte Carlo over both sweeps and the point: the same draws, so the same percentiles
+    np.testing.assert_allclose(low, expected.magnitude[5.0] / 1e6, rtol=1e-12)
+    np.testing.assert_allclose(high, expected.magnitude[95.0] / 1e6, rtol=1e-12)
+    assert "Tolerance band" in app.plots.summary.object and "200 uniform samples, seed 3" in app.plots.summary.object
+    x, low, high = area(app.plots.frame(("loss_factor", "amplitude")), "5–95 % band")
+    assert np.all(low < high) and len(x) == 120
+    # the card draws each direction's band
+    card = app.card.frame("translation")
+    assert {e.label for e in card} >= {"axial band", "radial band"}
+    app.state.band_on = False
+    assert all(e.label != "5–95 % band" for e in app.plots.frame(("magnitude", "frequency")))
+
+
+def test_tolerances_that_cannot_be_used_say_why_and_keep_the_plots(app):
+    v = app.whatif
+    v.tolerance_inputs["outer_radius"].value = 50  # b − 50 % < a
+    app.state.band_on = True
+    app.tabs.active = 0
+    assert "no rubber" in app.state.band_message and "No tolerance band" in app.plots.summary.object
+    assert "No band" in v.band_status.object
+    assert all(e.label != "5–95 % band" for e in app.plots.frame(("magnitude", "frequency")))
+    v.tolerance_inputs["outer_radius"].value = 0
+    app.state.band_from_fit = True  # no fit yet
+    assert "no fit yet" in app.state.band_message.lower()
+
+
+def test_a_fits_covariance_makes_the_band(app):
+    data = synthetic_stiffness(PAPER_B, np.linspace(5, 155, 20), [1e-5, 1e-4, 3.5e-4], noise=0.005, seed=1)
+    app.state.measured = data
+    app.state.fit_result = fit = fit_global(PAPER_B, data, intervals=False)
+    app.state.load_design(fit.design)
+    app.state.param.update(band_on=True, band_from_fit=True, band_samples=100)
+    app.tabs.active = 0
+    assert app.state.band_message == ""
+    f, low, high = area(app.plots.frame(("magnitude", "frequency")), "5–95 % band")
+    k = np.abs(stiffness_points(app.state.design, f, app.state.amplitude * 1e-3)) / 1e6
+    assert np.all(low < k) and np.all(k < high) and np.all((high - low) / k < 0.05)
+
+
+def test_the_sensitivity_bars_follow_the_operating_point(app):
+    v = app.whatif
+    app.tabs.active = len(App.LAZY_TABS)  # the What-ifs tab
+    app.state.amplitude = 0.3
+    bars_k, bars_eta = v.bars.current
+    expected = elasticities(app.state.design, app.state.frequency_hz, 0.3e-3)
+    shown = dict(zip(bars_k.dimension_values(0), bars_k.dimension_values(1)))
+    assert shown == pytest.approx({SYMBOLS[n]: e["magnitude"] for n, e in expected.items()}, rel=1e-12)
+    values = np.abs(bars_k.dimension_values(1))
+    assert np.all(np.diff(values) <= 0)  # largest first
+    assert "At 10 Hz and 0.3 mm" in v.sentence.object
+
+
+def test_the_design_form_finds_a_design_and_the_explorer_takes_it(app):
+    v = app.whatif
+    v.param.update(target_magnitude=4.5, loss_factor_min=0.12, b_max_mm=40.0, length_max_mm=100.0)
+    spec = json.loads(v._targets_file().getvalue())
+    assert spec["targets"][0]["magnitude"] == pytest.approx(4.5e6) and spec["fixed"] == ["inner_radius"]
+    v.run()
+    assert v.found.feasible and "meets every target" in v.result.object
+    v.use_solution(0)
+    d = app.state.design
+    assert d.geometry.inner_radius == PAPER_B.geometry.inner_radius and d.geometry.outer_radius <= 0.040 + 1e-12
+    assert abs(complex(stiffness_points(d, 10.0, 1e-4))) == pytest.approx(4.5e6, rel=1e-6)
+    assert app.state.frequency_hz == 10.0 and app.state.amplitude == pytest.approx(0.1)
+
+
+def test_the_design_form_says_when_targets_cannot_be_met(app):
+    v = app.whatif
+    v.run()
+    assert "give at least one target" in v.result.object
+    v.param.update(target_magnitude=400.0, b_max_mm=40.0, length_max_mm=100.0, thickness_min_mm=5.0)
+    v.run()
+    assert not v.found.feasible and "cannot be met" in v.result.object and "closest" in v.result.object
+    assert v.use.label == "Take the closest into the explorer"
