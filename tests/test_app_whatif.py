@@ -81,6 +81,8 @@ def test_the_sensitivity_bars_follow_the_operating_point(app):
     expected = elasticities(app.state.design, app.state.frequency_hz, 0.3e-3)
     shown = dict(zip(bars_k.dimension_values(0), bars_k.dimension_values(1)))
     assert shown == pytest.approx({SYMBOLS[n]: e["magnitude"] for n, e in expected.items()}, rel=1e-12)
+    shown = dict(zip(bars_eta.dimension_values(0), bars_eta.dimension_values(1)))
+    assert shown == pytest.approx({SYMBOLS[n]: e["loss_factor"] for n, e in expected.items()}, rel=1e-12, abs=1e-15)
     values = np.abs(bars_k.dimension_values(1))
     assert np.all(np.diff(values) <= 0)  # largest first
     assert "At 10 Hz and 0.3 mm" in v.sentence.object
