@@ -48,6 +48,11 @@ factor* is on; radial and conical always use the finite-element table (the rubbe
 bonded sleeves, ends free, b/a 1.2–4 and L/(b − a) 0.5–12). Each direction's equivalent strain
 follows from the energy balance, ε_eq = x̂ √(S / (4V)).
 
+**What-ifs.** Tolerances (± % per parameter, or a fit's covariance) become 5–95 % bands on the
+stiffness plots (a Monte Carlo with a stated seed, the first-order spread beside it); the
+sensitivities of |K| and the loss factor follow the operating point; targets on |K|, the loss
+factor and the radial/axial ratio find the nearest design that meets them, or say why none can.
+
 **Files.** *Measured stiffness* (CSV): a header row `frequency_hz,amplitude,magnitude,loss_factor`
 (or `stiffness_real,stiffness_imag` instead of the last two), then one row per point; amplitude
 the peak displacement in m (axial, radial) or angle in rad (torsion, conical), |K| in N/m or N·m/rad. *Measured

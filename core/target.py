@@ -326,8 +326,12 @@ def _why(problem: Problem, closest: Solution) -> str:
 
 
 def _number(key: str, value: Any, positive: bool = True) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise TargetError(f"{key}: must be a number, got {value!r}")
+    try:
+        finite = not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
+    except OverflowError:  # an integer past 1e308
+        finite = False
+    if not finite:
+        raise TargetError(f"{key}: must be a finite number, got {str(value)[:40]}")
     if positive and value <= 0:
         raise TargetError(f"{key}: must be positive, got {value!r}")
     return float(value)

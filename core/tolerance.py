@@ -92,7 +92,13 @@ class FitCovariance:
 
 
 def _finite(v) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+    """A number that a float holds (not a bool, NaN, an infinity, or an integer past 1e308)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return False
+    try:
+        return math.isfinite(v)
+    except OverflowError:
+        return False
 
 
 @dataclass(frozen=True)
@@ -116,7 +122,7 @@ class Tolerances:
                 if name not in SENSITIVITY_PARAMETERS:
                     raise ToleranceError(f"tolerances.{name}: unknown parameter (known: {', '.join(SENSITIVITY_PARAMETERS)})")
                 if not _finite(h) or h < 0:
-                    raise ToleranceError(f"tolerances.{name}: must be a number ≥ 0, got {h!r}")
+                    raise ToleranceError(f"tolerances.{name}: must be a number ≥ 0, got {str(h)[:40]}")
                 if kind == "relative" and h >= MAX_RELATIVE:
                     raise ToleranceError(f"tolerances.{name}: ±{100 * h:g} % is not a tolerance (at most "
                                          f"{100 * MAX_RELATIVE:g} %)")
@@ -124,15 +130,15 @@ class Tolerances:
         if both:
             raise ToleranceError(f"tolerances.{min(both)}: given twice (relative and absolute)")
         if self.distribution not in DISTRIBUTIONS:
-            raise ToleranceError(f"distribution: must be one of {', '.join(DISTRIBUTIONS)}, got {self.distribution!r}")
+            raise ToleranceError(f"distribution: must be one of {', '.join(DISTRIBUTIONS)}, got {str(self.distribution)[:40]}")
         if isinstance(self.samples, bool) or not isinstance(self.samples, int) or \
                 not SAMPLE_RANGE[0] <= self.samples <= SAMPLE_RANGE[1]:
-            raise ToleranceError(f"samples: a whole number from {SAMPLE_RANGE[0]} to {SAMPLE_RANGE[1]}, got {self.samples!r}")
+            raise ToleranceError(f"samples: a whole number from {SAMPLE_RANGE[0]} to {SAMPLE_RANGE[1]}, got {str(self.samples)[:40]}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or not 0 <= self.seed < 2**63:
-            raise ToleranceError(f"seed: a whole number from 0 to 2^63 − 1, got {self.seed!r}")
+            raise ToleranceError(f"seed: a whole number from 0 to 2^63 − 1, got {str(self.seed)[:40]}")
         if not self.percentiles or any(not _finite(q) or not 0 <= q <= 100 for q in self.percentiles) or \
                 len(self.percentiles) > 9:
-            raise ToleranceError(f"percentiles: one to nine numbers from 0 to 100, got {list(self.percentiles)!r}")
+            raise ToleranceError(f"percentiles: one to nine numbers from 0 to 100, got {str(list(self.percentiles))[:60]}")
 
     @property
     def varied(self) -> bool:
@@ -279,10 +285,10 @@ def _spread(name: str, value: Any) -> tuple[str, float]:
         m = _PERCENT.match(value)
         if not m:
             raise ToleranceError(f"tolerances.{name}: give a percentage such as \"10%\" or a number in SI units, "
-                                 f"got {value!r}")
+                                 f"got {str(value)[:40]}")
         return "relative", float(value.strip().rstrip("%")) / 100.0
     if not _finite(value):
-        raise ToleranceError(f"tolerances.{name}: give a percentage such as \"10%\" or a number in SI units, got {value!r}")
+        raise ToleranceError(f"tolerances.{name}: give a percentage such as \"10%\" or a number in SI units, got {str(value)[:40]}")
     return "absolute", float(value)
 
 
@@ -303,10 +309,10 @@ def tolerances_from_dict(data: Any, fit_report: Any = None) -> Tolerances:
         (relative if kind == "relative" else absolute)[str(name)] = h
     use_fit = data.get("fit_covariance", False)
     if not isinstance(use_fit, bool):
-        raise ToleranceError(f"fit_covariance: true or false, got {use_fit!r}")
+        raise ToleranceError(f"fit_covariance: true or false, got {str(use_fit)[:40]}")
     percentiles = data.get("percentiles", list(PERCENTILES))
     if not isinstance(percentiles, list):
-        raise ToleranceError(f"percentiles: a list of numbers from 0 to 100, got {percentiles!r}")
+        raise ToleranceError(f"percentiles: a list of numbers from 0 to 100, got {str(percentiles)[:60]}")
     tol = Tolerances(relative, absolute, data.get("distribution", "uniform"), data.get("samples", SAMPLES),
                      data.get("seed", 0), tuple(percentiles),
                      FitCovariance.from_report(fit_report) if use_fit else None)

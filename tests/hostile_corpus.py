@@ -230,6 +230,84 @@ def option_cases(folder: Path, design: Path, measured: Path) -> list[Case]:
     return [Case(f"options: {name}", tuple(argv)) for name, argv in argvs.items()]
 
 
+TOLERANCES = {"tolerances": {"shear_modulus": "10%", "length": 0.0005}, "samples": 50, "seed": 1}
+TARGETS = {"design": DESIGN, "targets": [{"mode": "axial", "frequency_hz": 10, "amplitude": 1e-4, "magnitude": 4e6}],
+           "limits": {"outer_radius": {"max": 0.04}}}
+
+
+def _changed(base: dict, change) -> str:
+    data = json.loads(json.dumps(base))
+    change(data)
+    return json.dumps(data)
+
+
+def _put(path: tuple, text: str):
+    """A change that puts the JSON ``text`` at ``path`` (its last key replaced)."""
+    def change(data):
+        holder = data
+        for key in path[:-1]:
+            holder = holder[key]
+        holder[path[-1]] = "<<HERE>>"
+    return change, text
+
+
+def whatif_cases(folder: Path, design: Path) -> list[Case]:
+    """Tolerance files for ``stiffness --tolerance`` and targets files for ``design``, broken."""
+    d = str(design)
+    texts: dict[str, tuple[str, str]] = {}  # name → (kind, text)
+    for where in (("tolerances", "shear_modulus"), ("tolerances", "length"), ("samples",), ("seed",),
+                  ("distribution",), ("percentiles",), ("fit_covariance",)):
+        for bad in BAD_NUMBERS:
+            change, text = _put(where, bad)
+            texts[f"tolerance {'.'.join(where)} = {bad[:20]}"] = (
+                "tolerance", _changed(TOLERANCES, change).replace('"<<HERE>>"', text))
+    for where in (("targets", 0, "frequency_hz"), ("targets", 0, "amplitude"), ("targets", 0, "magnitude"),
+                  ("limits", "outer_radius", "max"), ("solutions",), ("targets", 0, "mode"), ("targets",)):
+        for bad in BAD_NUMBERS:
+            change, text = _put(where, bad)
+            texts[f"targets {'.'.join(map(str, where))} = {bad[:20]}"] = (
+                "targets", _changed(TARGETS, change).replace('"<<HERE>>"', text))
+    texts.update({
+        "tolerance: nested 100 000 deep": ("tolerance", "[" * 100_000 + "]" * 100_000),
+        "targets: nested 100 000 deep": ("targets", "[" * 100_000 + "]" * 100_000),
+        "tolerance: 2 MB": ("tolerance", json.dumps({"tolerances": {"length": "1%"}, "pad": "x" * 2_000_000})),
+        "targets: 2 MB": ("targets", json.dumps({**TARGETS, "pad": "x" * 2_000_000})),
+        "tolerance: empty": ("tolerance", ""),
+        "targets: empty": ("targets", ""),
+        "targets: 5000 targets": ("targets", json.dumps({**TARGETS, "targets": TARGETS["targets"] * 5000})),
+        "targets: contradicting": ("targets", json.dumps({**TARGETS, "targets": [
+            {"mode": "axial", "frequency_hz": 10, "amplitude": 1e-4, "magnitude": {"min": 5e6}},
+            {"mode": "axial", "frequency_hz": 10, "amplitude": 1e-4, "magnitude": {"max": 4e6}}]})),
+        "targets: 1e30 N/m in a millimetre": ("targets", json.dumps({**TARGETS, "targets": [
+            {"mode": "torsion", "frequency_hz": 1e5, "amplitude": 1.0, "magnitude": 1e30}],
+            "limits": {"length": {"max": 0.001}}})),
+        "targets: a ratio of one mode": ("targets", json.dumps({**TARGETS, "targets": [
+            {"ratio": ["axial", "axial"], "frequency_hz": 10, "amplitude": 1e-4, "magnitude": 2}]})),
+        "targets: every material free": ("targets", json.dumps({**TARGETS, "free_material": {
+            n: {"min": 1e-30, "max": 1e30} for n in DESIGN["material"]}})),
+        "tolerance: 5000 samples on a big grid": ("tolerance", json.dumps({**TOLERANCES, "samples": 5000})),
+        "tolerance: 99 % of b": ("tolerance", json.dumps({"tolerances": {"outer_radius": "89%"}})),
+    })
+    cases = []
+    for name, (kind, text) in texts.items():
+        path = folder / f"whatif_{len(cases)}.json"
+        path.write_text(text, encoding="utf-8")
+        if kind == "tolerance":
+            freq = ("1", "100", "5000") if "big grid" in name else ("1", "100", "5")
+            argv = ("stiffness", d, "--freq", *freq, "--amp", "1e-4", "1e-3", "--tolerance", str(path))
+        else:
+            argv = ("design", str(path))
+        cases.append(Case(f"what-ifs: {name}", argv))
+    bad_bytes = folder / "whatif_latin1.json"
+    bad_bytes.write_bytes('{"tolerances": {"length": "1%"}, "x": "é"}'.encode("latin-1"))
+    cases.append(Case("what-ifs: a tolerance file not UTF-8", ("stiffness", d, "--freq", "1", "10", "2", "--amp",
+                                                             "1e-4", "--tolerance", str(bad_bytes))))
+    cases.append(Case("what-ifs: a missing targets file", ("design", str(folder / "none.json"))))
+    cases.append(Case("what-ifs: a folder as tolerance file", ("stiffness", d, "--freq", "1", "10", "2", "--amp",
+                                                               "1e-4", "--tolerance", str(folder))))
+    return cases
+
+
 def corpus(folder: Path) -> list[Case]:
     folder.mkdir(parents=True, exist_ok=True)
     design = folder / "good_design.json"
@@ -238,7 +316,7 @@ def corpus(folder: Path) -> list[Case]:
     measured.write_text("frequency_hz,amplitude,magnitude,loss_factor\n"
                         + "".join(",".join(r) + "\n" for r in _stiffness_rows()))
     return (design_cases(folder) + measured_cases(folder, design) + loop_cases(folder, design, measured)
-            + option_cases(folder, design, measured))
+            + option_cases(folder, design, measured) + whatif_cases(folder, design))
 
 
 class _Hang(Exception):
