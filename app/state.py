@@ -27,7 +27,7 @@ from core.data import (
 from core.design import SIZE_RANGE, as_dict
 from core.fit import PARAMETERS as MATERIAL_PARAMETERS
 from core.fit import FitResult, fit_global, fit_two_step, predicted, selection
-from core.tolerance import SAMPLES, FitCovariance, ToleranceError, Tolerances
+from core.tolerance import SAMPLES, FitCovariance, ToleranceError, Tolerances, band, band_columns
 
 from . import curves, units
 from .units import FREQUENCY_BOUNDS
@@ -523,9 +523,17 @@ class ExplorerState(param.Parameterized):
 
     def stiffness_table(self, n_freq: int = 25, n_amp: int = 25) -> dict:
         """The docs/files.md stiffness table over the sweeps' frequency range and the
-        Fletcher–Gent amplitude range (SI units)."""
-        r = stiffness(self.design, self.frequency_grid(n_freq), self._si_amplitude(self.amplitude_grid(n_amp)))
-        return r.table()
+        Fletcher–Gent amplitude range (SI units); with the tolerance bands on, their percentile
+        columns too (those of ``bushing stiffness --tolerance``)."""
+        f, x = self.frequency_grid(n_freq), self._si_amplitude(self.amplitude_grid(n_amp))
+        table = stiffness(self.design, f, x).table()
+        tolerances = self.checked_tolerances()
+        if tolerances is not None:
+            try:
+                table.update(band_columns(band(self.design, f[None, :], np.asarray(x)[:, None], tolerances)))
+            except ToleranceError as exc:
+                self.band_message = str(exc)
+        return table
 
 
 def _match_shown(design: Design, known) -> Design:
