@@ -347,6 +347,16 @@ def _range(key: str, spec: Any) -> tuple[float | None, float | None]:
     return low, high
 
 
+def _ranges(key: str, spec: Any, known: tuple[str, ...]) -> dict[str, tuple[float | None, float | None]]:
+    """An object of name → {min, max}, its names from ``known``."""
+    if not isinstance(spec, Mapping):
+        raise TargetError(f"{key}: an object of name → {{min, max}}")
+    unknown = [n for n in spec if n not in known]
+    if unknown:
+        raise TargetError(f"{key}.{unknown[0]}: unknown (known: {', '.join(known)})")
+    return {name: _range(f"{key}.{name}", r) for name, r in spec.items()}
+
+
 def _target(i: int, spec: Any, tolerance: float, start: Design) -> Target:
     key = f"targets[{i}]"
     if not isinstance(spec, Mapping):
@@ -415,13 +425,7 @@ def problem_from_dict(data: Any) -> Problem:
         raise TargetError(f"targets: a list of 1 to {MAX_TARGETS} targets")
     parsed = tuple(_target(i, t, tolerance, start) for i, t in enumerate(targets))
     limits = dict(DEFAULT_LIMITS)
-    given = data.get("limits", {})
-    if not isinstance(given, Mapping):
-        raise TargetError("limits: an object of geometry name → {min, max}")
-    for name, spec in given.items():
-        if name not in GEOMETRY_LIMITS:
-            raise TargetError(f"limits.{name}: unknown (known: {', '.join(GEOMETRY_LIMITS)})")
-        low, high = _range(f"limits.{name}", spec)
+    for name, (low, high) in _ranges("limits", data.get("limits", {}), GEOMETRY_LIMITS).items():
         low = DEFAULT_LIMITS[name][0] if low is None else low
         high = DEFAULT_LIMITS[name][1] if high is None else high
         if not SIZE_RANGE[0] <= low < high <= SIZE_RANGE[1]:
@@ -431,17 +435,9 @@ def problem_from_dict(data: Any) -> Problem:
     if not isinstance(fixed, list) or any(n not in ("inner_radius", "thickness", "length") for n in fixed):
         raise TargetError("fixed: a list of inner_radius, thickness, length (held at the start design's)")
     free = {}
-    spec = data.get("free_material", {})
-    if not isinstance(spec, Mapping):
-        raise TargetError("free_material: an object of material parameter → {min, max}")
-    for name, r in spec.items():
-        if name not in MATERIAL_PARAMETERS:
-            raise TargetError(f"free_material.{name}: unknown (known: {', '.join(MATERIAL_PARAMETERS)})")
-        low, high = _range(f"free_material.{name}", r)
-        p_lo, p_hi = parameter(name).bounds
-        low, high = max(low or p_lo, p_lo, 1e-30), min(high or p_hi, p_hi)
-        if name == "fractional_order":
-            high = min(high, 1.0)
+    for name, (low, high) in _ranges("free_material", data.get("free_material", {}), MATERIAL_PARAMETERS).items():
+        p_lo, p_hi = parameter(name).bounds  # within the fitting range (α also ≤ 1)
+        low, high = max(low or p_lo, p_lo, 1e-30), min(high or p_hi, p_hi, 1.0 if name == "fractional_order" else math.inf)
         if not low < high:
             raise TargetError(f"free_material.{name}: an empty range")
         free[name] = (low, high)
