@@ -18,7 +18,7 @@ import numpy as np
 
 from .bushing import stiffness_points
 from .data import loss_factor
-from .design import Design, DesignError
+from .design import Design
 from .fit import PARAMETERS as MATERIAL_PARAMETERS
 
 GEOMETRY_PARAMETERS = ("inner_radius", "outer_radius", "length")
@@ -49,8 +49,8 @@ def log_derivatives(design: Design, frequency_hz, amplitude, names=SENSITIVITY_P
                 k = stiffness_points(design.replace(**{name: p * math.exp(sign * step)}), frequency_hz, amplitude,
                                      **kwargs)
                 ends.append((sign * step, k))
-            except DesignError:  # beyond the parameter's range (α > 1, b ≤ a): one side only
-                continue
+            except ValueError:  # beyond the parameter's range (α > 1, b ≤ a, the edge of the
+                continue        # finite-length table): one side only (DesignError is a ValueError)
         if len(ends) < 2:
             ends.append((0.0, stiffness_points(design, frequency_hz, amplitude, **kwargs)))
         (h1, k1), (h2, k2) = ends
