@@ -14,7 +14,7 @@ from .state import ExplorerState
 from .views import PlotView
 
 # what the tolerance bands depend on (app.state.ExplorerState.tolerances)
-BAND_PARAMETERS = ("tolerance_pct", "band_on", "band_distribution", "band_samples", "band_seed", "band_from_fit",
+BAND_PARAMETERS = ("tolerance_text", "band_on", "band_distribution", "band_samples", "band_seed", "band_from_fit",
                    "fit_result")
 GRID = (("magnitude", "frequency"), ("magnitude", "amplitude"), ("loss_factor", "frequency"),
         ("loss_factor", "amplitude"))

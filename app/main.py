@@ -87,7 +87,11 @@ class ShareLink(param.Parameterized):
 
 
 for _name in URL_NAMES:
-    if _name not in ("mode", "finite_length"):
+    if _name == "tolerance_text":
+        ShareLink.param.add_parameter(_name, param.String(default=""))
+    elif _name == "band_on":
+        ShareLink.param.add_parameter(_name, param.Boolean(default=False))
+    elif _name not in ("mode", "finite_length"):
         ShareLink.param.add_parameter(_name, param.Number(default=None, allow_None=True))
 
 

@@ -97,4 +97,6 @@ URL_NAMES = {
     "frequency_hz": "f_Hz",
     "freq_min": "fmin_Hz",
     "freq_max": "fmax_Hz",
+    "tolerance_text": "tol",
+    "band_on": "bands",
 }

@@ -32,6 +32,30 @@ from core.tolerance import SAMPLES, FitCovariance, ToleranceError, Tolerances, b
 from . import curves, units
 from .units import FREQUENCY_BOUNDS
 
+# a parameter's key in the tolerances of a link (tol=mu:10,L:1)
+TOLERANCE_KEYS = {"inner_radius": "a", "outer_radius": "b", "length": "L", "shear_modulus": "mu",
+                  "fractional_coefficient": "m", "fractional_order": "alpha", "friction_stress_max": "sigma",
+                  "friction_strain_half": "eps_half"}
+_TOLERANCE_NAMES = {v: k for k, v in TOLERANCE_KEYS.items()}
+
+
+def parse_tolerances(text: str) -> dict[str, float]:
+    """``mu:10,L:1`` → {"shear_modulus": 10.0, "length": 1.0} (± %); ToleranceError if a key is
+    unknown, given twice or its value is not a number from 0 to 89."""
+    out: dict[str, float] = {}
+    for item in filter(None, (part.strip() for part in text.split(","))):
+        key, _, value = item.partition(":")
+        name = _TOLERANCE_NAMES.get(key.strip())
+        try:
+            number = float(value)
+        except ValueError:
+            number = math.nan
+        if name is None or name in out or not 0.0 <= number <= 89.0:
+            raise ToleranceError(f"the tolerances {text[:80]!r}: give key:percent pairs, keys from "
+                                 f"{', '.join(TOLERANCE_KEYS.values())}, percents from 0 to 89")
+        out[name] = number
+    return out
+
 # display parameter → (design key, factor from display unit to SI)
 GEOMETRY_FIELDS = {
     "inner_radius_mm": ("inner_radius", 1e-3),
@@ -142,7 +166,8 @@ class ExplorerState(param.Parameterized):
                           "predicts the others, with the gap of each mode and amplitude.")
 
     # ---- what-ifs: tolerance bands ---------------------------------------------------------------
-    tolerance_pct = param.Dict(default={}, doc="Parameter (core name) → its tolerance, ± % of its value.")
+    tolerance_text = param.String(default="", doc="The tolerances in ± % as a link writes them (TOLERANCE_KEYS): "
+                                  "mu:10,L:1 is µ ±10 % and L ±1 %.")
     band_on = param.Boolean(default=False, label="Show tolerance bands on the stiffness plots")
     band_distribution = param.Selector(objects=["uniform", "normal"], default="uniform", label="Distribution",
                                        doc="Uniform over ± the tolerance, or normal with the tolerance at 3σ "
@@ -448,6 +473,16 @@ class ExplorerState(param.Parameterized):
 
     def operating_point(self, design: Design | None = None) -> dict:
         return curves.operating_point(design or self.design, self.frequency_hz, self.amplitude)
+
+    @property
+    def tolerance_pct(self) -> dict[str, float]:
+        """The tolerances by parameter (core names), ± %. Raises ToleranceError for a text (a
+        link's) that is not a list of known parameters with numbers."""
+        return parse_tolerances(self.tolerance_text)
+
+    @tolerance_pct.setter
+    def tolerance_pct(self, values: dict[str, float]):
+        self.tolerance_text = ",".join(f"{TOLERANCE_KEYS[n]}:{v:g}" for n, v in values.items() if v)
 
     def tolerances(self) -> Tolerances | None:
         """The tolerances the bands are drawn with (:class:`core.tolerance.Tolerances`), None

@@ -14,6 +14,7 @@ import param
 
 from core.sensitivity import SENSITIVITY_PARAMETERS, SYMBOLS, elasticities, ranked, sentence
 from core.target import Found, TargetError, problem_from_dict, solve
+from core.tolerance import ToleranceError
 
 from . import plots, units
 from .live import LivePlot
@@ -67,9 +68,10 @@ class WhatIfView(PlotView):
     message = param.String(default="")
 
     def __init__(self, state: ExplorerState, **params):
+        self._showing = False
         super().__init__(state, **params)
         self.tolerance_inputs = {
-            n: pn.widgets.FloatInput(label=f"{NAMES[n]} ± %", value=state.tolerance_pct.get(n, 0.0), start=0.0,
+            n: pn.widgets.FloatInput(label=f"{NAMES[n]} ± %", value=self._shown_tolerances().get(n, 0.0), start=0.0,
                                      end=89.0, step=0.5, width=170)
             for n in SENSITIVITY_PARAMETERS}
         for name, widget in self.tolerance_inputs.items():
@@ -98,10 +100,29 @@ class WhatIfView(PlotView):
 
     # ---- tolerances ------------------------------------------------------------------------------
 
+    def _shown_tolerances(self) -> dict[str, float]:
+        try:
+            return self.state.tolerance_pct
+        except ToleranceError:  # a link's text that is no list of tolerances: its message says so
+            return {}
+
     def _set_tolerance(self, name: str, value):
-        values = dict(self.state.tolerance_pct)
+        if self._showing:
+            return
+        values = {n: w.value or 0.0 for n, w in self.tolerance_inputs.items()}
         values[name] = float(value or 0.0)
-        self.state.tolerance_pct = {n: v for n, v in values.items() if v}
+        self.state.tolerance_pct = values
+
+    @param.depends("state.tolerance_text", watch=True)
+    def _show_tolerances(self):
+        """A link (or the back button) sets the tolerances: the inputs show them."""
+        values = self._shown_tolerances()
+        self._showing = True  # the inputs follow the state here, not the other way round
+        try:
+            for name, widget in self.tolerance_inputs.items():
+                widget.value = values.get(name, 0.0)
+        finally:
+            self._showing = False
 
     @param.depends("state.band_message", "state.band_on", "state.fit_result", "state.band_from_fit", watch=True)
     def _on_band(self):

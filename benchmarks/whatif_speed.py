@@ -52,8 +52,8 @@ def main():
     from app.main import App
 
     app = App()
-    app.state.param.update(tolerance_pct={"shear_modulus": 10.0, "friction_stress_max": 15.0, "fractional_order": 5.0},
-                           band_on=True)
+    app.state.tolerance_pct = {"shear_modulus": 10.0, "friction_stress_max": 15.0, "fractional_order": 5.0}
+    app.state.band_on = True
     plain = App()
     line("the explorer's whole update, server side, bands on", median_ms(app.plots._update), 300)
     line("the explorer's whole update, server side, bands off", median_ms(plain.plots._update), 300)

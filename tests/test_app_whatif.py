@@ -116,3 +116,23 @@ def test_the_design_form_says_when_targets_cannot_be_met(app):
     v.run()
     assert not v.found.feasible and "cannot be met" in v.result.object and "closest" in v.result.object
     assert v.use.label == "Take the closest into the explorer"
+
+
+def test_tolerances_travel_in_a_link(app):
+    from app.state import parse_tolerances
+    from core.tolerance import ToleranceError
+
+    assert parse_tolerances("mu:10, L:0.5") == {"shear_modulus": 10.0, "length": 0.5}
+    for bad in ("mu:ten", "hardness:5", "mu:10,mu:5", "mu:95", "mu"):
+        with pytest.raises(ToleranceError, match="key:percent pairs"):
+            parse_tolerances(bad)
+    v = app.whatif
+    app.state.param.update(tolerance_text="sigma:15,alpha:5", band_on=True)  # as a link sets them
+    assert v.tolerance_inputs["friction_stress_max"].value == 15 and v.tolerance_inputs["fractional_order"].value == 5
+    assert v.tolerance_inputs["shear_modulus"].value == 0
+    v.tolerance_inputs["length"].value = 2  # and an input writes the link's text
+    assert app.state.tolerance_text == "L:2,alpha:5,sigma:15"
+    app.tabs.active = 0
+    assert "Tolerance band" in app.plots.summary.object
+    app.state.tolerance_text = "mu:lots"  # a hand-edited link: said, and no band
+    assert "key:percent pairs" in app.state.band_message and "No tolerance band" in app.plots.summary.object

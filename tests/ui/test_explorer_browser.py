@@ -490,3 +490,17 @@ def test_what_ifs_bands_sensitivities_and_a_design_from_targets(page, explorer_u
     page.get_by_text("VP 40/70120 (Paper B) (from targets)").first.wait_for(timeout=10000)
     page.get_by_text("Explorer", exact=True).click()
     page.get_by_text("|K| = 4.5 kN/mm").wait_for(timeout=20000)
+
+
+def test_a_link_brings_the_tolerance_bands(page, explorer_url):
+    open_explorer(page, explorer_url + "?tol=mu:10,L:1&bands=true")
+    page.get_by_text("Tolerance band (5–95 %").wait_for(timeout=20000)
+    wait_quiet(page)
+    assert "5–95 % band" in plots(page)["|K| against frequency"]["legends"]
+    page.get_by_text("What-ifs", exact=True).click()
+    field = page.get_by_label("Shear modulus µ ± %")
+    field.wait_for(timeout=20000)
+    assert field.input_value() == "10"
+    field.fill("12")
+    field.press("Enter")
+    page.wait_for_url(re.compile(r"tol=L(%3A|:)1(%2C|,)mu(%3A|:)12"), timeout=10000)
