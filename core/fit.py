@@ -36,6 +36,7 @@ from .bushing import check_measured_amplitude, loop_force, stiffness_points
 from .data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from .design import Design, as_dict
 from .effects import EFFECTS, Parameter, split_id
+from .shape import OutsideTable
 from .uncertainty import CONFIDENCE, profile
 
 PARAMETERS = (
@@ -105,7 +106,10 @@ def check_data_amplitudes(design: Design, data: MeasuredStiffness) -> None:
         check_measured_amplitude(design, data.amplitude)
         return
     for mode in np.unique(data.mode.astype(str)):
-        check_measured_amplitude(design.in_mode(mode), data.amplitude[data.mode == mode], f"{mode} amplitude")
+        try:
+            check_measured_amplitude(design.in_mode(mode), data.amplitude[data.mode == mode], f"{mode} amplitude")
+        except OutsideTable as exc:  # this bushing has no shape factor in that direction
+            raise ValueError(f"the data's {mode} rows: {exc}") from None
 
 
 def gaps_by_mode(k: np.ndarray, data: MeasuredStiffness) -> dict[str, float]:

@@ -151,3 +151,15 @@ def test_a_bad_file_among_several_is_left_out_with_its_message():
     assert "not loaded; the other files are" in s.data_message
     assert s.load_measured_files({"good.csv": good}) and s.data_message == ""
     assert not s.load_measured_files({"bad.csv": bad}) and len(s.measured) == 15  # none good: the last data kept
+
+
+def test_a_mode_this_bushing_cannot_compute_is_named():
+    """Radial rows for a bushing outside the finite-length table (b/a = 6): the message names the
+    rows and the table's range, in the fit and in the diagnosis."""
+    from core.diagnose import diagnose
+
+    wide = PAPER_B.replace(outer_radius=0.12)
+    data = multi_mode(modes=("axial", "radial"), per_amplitude=5)
+    for run in (lambda: fit_global(wide, data), lambda: diagnose(wide, data, held_out=False)):
+        with pytest.raises(ValueError, match=r"the data's radial rows: the finite-length shape factors cover b/a 1\.2–4"):
+            run()
