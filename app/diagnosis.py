@@ -151,9 +151,11 @@ class DiagnosisView(pn.viewable.Viewer):
                                if s.message else "")
         if s.data is not None:
             d = s.data
-            amps = np.unique(d.amplitude)
+            modes = d.modes(s.explorer.design.mode).astype(str)
+            per_mode = [f"{m} {int(np.sum(modes == m))} points at {np.unique(d.amplitude[modes == m]).size} "
+                        f"amplitude(s)" for m in np.unique(modes)]
             self.source.object = (f"**Data**: {s.source}: {len(d)} points, {d.frequency_hz.min():.3g}–"
-                                  f"{d.frequency_hz.max():.3g} Hz, {amps.size} amplitude(s).")
+                                  f"{d.frequency_hz.max():.3g} Hz; {'; '.join(per_mode)}.")
         else:
             self.source.object = "_No data loaded yet._"
         self.run.disabled = s.running or s.data is None
