@@ -21,9 +21,10 @@ CARD_MODES = ("axial", "radial", "torsion", "conical")
 
 
 def card_design(design: Design, mode: str) -> Design:
-    """``design`` in ``mode`` with the card's shape factor."""
+    """``design`` in ``mode`` with the card's shape factor (a test rig's apparent mass stays
+    with its own mode, as :meth:`core.design.Design.in_mode` keeps it)."""
     shape = design.shape if design.shape == "long" and mode in ("axial", "torsion") else "finite"
-    return design.replace(mode=mode, shape=shape)
+    return design.replace(mode=mode, shape=shape, effects=design.portable_effects)
 
 
 def card(design: Design, frequency_hz: float, displacement: float, angle: float) -> list[dict]:

@@ -44,6 +44,17 @@ def test_an_apparent_mass_acts_in_its_own_mode_only():
     assert again == torsion
 
 
+def test_the_card_puts_a_rigs_mass_on_its_own_direction_only():
+    from core.card import card
+
+    plain, massive = (card(d, 100.0, 1e-4, 1e-2) for d in (PAPER_B, PAPER_B.replace(effects={"inertia": {"mass": 0.5}})))
+    for r0, r1 in zip(plain, massive):
+        if r0["mode"] == "axial":  # K − ω²M on the axial rig
+            assert r1["stiffness_real"] == pytest.approx(r0["stiffness_real"] - (2 * np.pi * 100.0) ** 2 * 0.5, rel=1e-12)
+        else:
+            assert r1["magnitude"] == r0["magnitude"], r0["mode"]
+
+
 @pytest.mark.parametrize("effects, match", [
     ({"viscous@axial": {"viscosity": 1.0}}, "only an effect of the test rig"),
     ({"inertia@shear": {"mass": 1.0}}, "the mode after @ must be one of"),
