@@ -235,39 +235,56 @@ class ExplorerData:
     bands: dict | None = None  # operating_bands, when tolerances are set
 
 
-def operating_bands(design: Design, frequency_hz: float, amplitude: float, f, x, tolerances) -> dict:
+def operating_bands(design: Design, frequency_hz: float, amplitude: float, f, x, tolerances,
+                    cache: dict | None = None) -> dict:
     """Tolerance bands (:mod:`core.tolerance`) of the operating curves: against frequency ``f``
     at the operating ``amplitude`` and against amplitude ``x`` (display units) at the operating
-    frequency, one Monte Carlo over both and the operating point itself. For each of
-    ``"frequency"`` and ``"amplitude"``, (low, high) of ``magnitude`` (display unit) and
-    ``loss_factor`` at the tolerances' first and last percentiles; ``"point"`` the operating
-    point's band, spreads and first-order spreads."""
+    frequency. For each of ``"frequency"`` and ``"amplitude"``, (low, high) of ``magnitude``
+    (display unit) and ``loss_factor`` at the tolerances' first and last percentiles; ``"point"``
+    the operating point's band, spreads and first-order spreads.
+
+    Three Monte Carlos with the same draws (the seed): each curve's (a frequency sweep at one
+    strain computes the friction branch once, an amplitude sweep the fractional branch once) and
+    the point's. ``cache`` (a dict the caller keeps) holds the last few: moving the operating
+    amplitude recomputes the frequency curve's band and the point's, not the amplitude curve's."""
     from core.tolerance import band
 
     mode = design.mode
-    a_si, x_si = units.to_si_amplitude(amplitude, mode), units.to_si_amplitude(x, mode)
-    f, n = np.asarray(f, dtype=float), len(f)
-    b = band(design, np.concatenate([f, np.full(x_si.size, frequency_hz), [frequency_hz]]),
-             np.concatenate([np.full(n, a_si), x_si, [a_si]]), tolerances)
-    low, high = min(b.percentiles), max(b.percentiles)
-    out = {}
-    for against, part in (("frequency", slice(0, n)), ("amplitude", slice(n, -1))):
-        out[against] = {"magnitude": tuple(units.display_stiffness(b.magnitude[q][part], mode) for q in (low, high)),
-                        "loss_factor": tuple(b.loss_factor[q][part] for q in (low, high))}
-    out["point"] = {"percentiles": (low, high), "samples": b.samples, "seed": b.seed, "distribution": b.distribution,
-                    "magnitude": tuple(float(units.display_stiffness(b.magnitude[q][-1], mode)) for q in (low, high)),
-                    "loss_factor": tuple(float(b.loss_factor[q][-1]) for q in (low, high)),
-                    "std_magnitude_pct": float(100 * b.std_magnitude[-1] / b.nominal_magnitude[-1]),
-                    "first_order_magnitude_pct": float(100 * b.first_order_magnitude[-1] / b.nominal_magnitude[-1]),
-                    "std_loss_factor": float(b.std_loss_factor[-1]),
-                    "first_order_loss_factor": float(b.first_order_loss_factor[-1])}
+    a_si, x_si = float(units.to_si_amplitude(amplitude, mode)), units.to_si_amplitude(x, mode)
+    f = np.asarray(f, dtype=float)
+
+    def cached(*points):
+        key = (design, repr(tolerances), *(np.asarray(p, dtype=float).tobytes() for p in points))
+        if cache is not None and key in cache:
+            return cache[key]
+        result = band(design, *points, tolerances)
+        if cache is not None:
+            while len(cache) >= 6:
+                cache.pop(next(iter(cache)))
+            cache[key] = result
+        return result
+
+    swept = {"frequency": cached(f, a_si), "amplitude": cached(frequency_hz, x_si)}
+    point = cached(frequency_hz, a_si)
+    low, high = min(point.percentiles), max(point.percentiles)
+    out = {against: {"magnitude": tuple(units.display_stiffness(b.magnitude[q], mode) for q in (low, high)),
+                     "loss_factor": tuple(b.loss_factor[q] for q in (low, high))}
+           for against, b in swept.items()}
+    out["point"] = {"percentiles": (low, high), "samples": point.samples, "seed": point.seed,
+                    "distribution": point.distribution,
+                    "magnitude": tuple(float(units.display_stiffness(point.magnitude[q], mode)) for q in (low, high)),
+                    "loss_factor": tuple(float(point.loss_factor[q]) for q in (low, high)),
+                    "std_magnitude_pct": float(100 * point.std_magnitude / point.nominal_magnitude),
+                    "first_order_magnitude_pct": float(100 * point.first_order_magnitude / point.nominal_magnitude),
+                    "std_loss_factor": float(point.std_loss_factor),
+                    "first_order_loss_factor": float(point.first_order_loss_factor)}
     return out
 
 
 def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq_range=(1.0, 100.0),
                   reference: Design | None = None, measured: MeasuredStiffness | None = None,
                   measured_loop: MeasuredLoop | None = None, n_freq: int = 120, n_amp: int = 120,
-                  tolerances=None) -> ExplorerData:
+                  tolerances=None, band_cache: dict | None = None) -> ExplorerData:
     """The explorer's curves at the operating point (``frequency_hz``, ``amplitude`` in display
     units). A reference in another mode than ``design`` is left out. With ``tolerances``
     (:class:`core.tolerance.Tolerances`), the operating curves' bands (:func:`operating_bands`)."""
@@ -285,7 +302,8 @@ def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq
     lp = hysteresis_loop(design, frequency_hz, amplitude)
     ref_loop = hysteresis_loop(ref, frequency_hz, amplitude) if ref is not None else None
     loop_points = measured_loop_points(measured_loop, mode)
-    bands = operating_bands(design, frequency_hz, amplitude, f, x, tolerances) if tolerances is not None else None
+    bands = (operating_bands(design, frequency_hz, amplitude, f, x, tolerances, band_cache)
+             if tolerances is not None else None)
     ranges = {"frequency": padded([f]), "amplitude": padded([x], log=True)}
     for quantity in ("magnitude", "loss_factor"):
         parts = [s[quantity] for s in sweeps.values()] + [s[quantity] for s in operating.values()]

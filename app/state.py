@@ -180,6 +180,7 @@ class ExplorerState(param.Parameterized):
     band_message = param.String(default="", doc="Why no band is drawn, if one was asked for.")
 
     def __init__(self, **params):
+        self._band_cache: dict = {}  # the last few tolerance bands (app.curves.operating_bands)
         self._loaded = []  # the last design loaded (a file, a fit): kept while the inputs show it
         super().__init__(**params)
         self.param.watch(self._keep_strain_on_mode_change, ["mode", "amplitude"])
@@ -519,7 +520,8 @@ class ExplorerState(param.Parameterized):
         try:
             return curves.explorer_data(self.design, self.frequency_hz, self.amplitude, freq_range=self.freq_range,
                                         reference=self.reference, measured=self.measured,
-                                        measured_loop=self.measured_loop, tolerances=tolerances)
+                                        measured_loop=self.measured_loop, tolerances=tolerances,
+                                        band_cache=self._band_cache)
         except ToleranceError as exc:  # a sample the model cannot compute: the plots without the band
             self.band_message = str(exc)
             return curves.explorer_data(self.design, self.frequency_hz, self.amplitude, freq_range=self.freq_range,

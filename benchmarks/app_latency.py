@@ -1,6 +1,6 @@
 """Explorer latency in real Chromium: prints figures, asserts nothing.
 
-    python benchmarks/app_latency.py [--changes 40] [--sessions 10]
+    python benchmarks/app_latency.py [--changes 40] [--sessions 10] [--query "tol=mu:10,L:1&bands=true"]
 
 Starts `bushing serve` on a free port, opens the explorer in the system Chromium and measures:
 
@@ -18,6 +18,9 @@ All N pages run in one Chromium on this same 2-core machine as the server, so th
 rendering competes with the server for the CPU; users on their own machines would not. For the
 simultaneous rounds the script also prints the CPU time per change of the server and of
 Chromium's processes (page renderers, GPU/compositor, browser), read from /proc.
+
+``--query`` opens the explorer with a link's query, e.g. the tolerance bands switched on (every
+change then recomputes a 500-sample band as well).
 
 Targets: median ≤ 150 ms and p95 ≤ 300 ms with one session; p95 ≤ 500 ms with 10 sessions;
 first load ≤ 3 s.
@@ -236,11 +239,11 @@ def ratios(name: str, a: dict, b: dict):
     print(f"  CPU per change {total[0]:.0f} / {total[1]:.0f} ms = {total[0] / total[1]:.2f}")
 
 
-async def main(n_changes, n_sessions):
+async def main(n_changes, n_sessions, query=""):
     port = free_port()
     server = start_server(port)
     try:
-        await measure(f"http://localhost:{port}/", server.pid, n_changes, n_sessions)
+        await measure(f"http://localhost:{port}/" + (f"?{query}" if query else ""), server.pid, n_changes, n_sessions)
     finally:
         server.terminate()
         server.wait(10)
@@ -250,5 +253,6 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("--changes", type=int, default=40)
     ap.add_argument("--sessions", type=int, default=10)
+    ap.add_argument("--query", default="", help="a link's query, e.g. tol=mu:10,L:1&bands=true")
     a = ap.parse_args()
-    asyncio.run(main(a.changes, a.sessions))
+    asyncio.run(main(a.changes, a.sessions, a.query))

@@ -29,11 +29,12 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from .bushing import stiffness_points
+from .bushing import MAX_STRAIN, factors, stiffness_points
 from .data import loss_factor
 from .design import Design, DesignError
 from .fit import FitResult, parameter
-from .sensitivity import SENSITIVITY_PARAMETERS, log_derivatives, value_of
+from .material import fractional_modulus, friction_modulus
+from .sensitivity import GEOMETRY_PARAMETERS, SENSITIVITY_PARAMETERS, log_derivatives, value_of
 
 DISTRIBUTIONS = ("uniform", "normal")
 SAMPLES = 500  # the default sample count
@@ -243,13 +244,19 @@ def band(design: Design, frequency_hz, amplitude, tolerances: Tolerances, **kwar
         raise ToleranceError(f"{tolerances.samples} samples × {points} points is more than {MAX_EVALUATIONS:.3g} "
                              "evaluations: use fewer samples or a coarser grid")
     nominal = np.broadcast_to(stiffness_points(design, f, x, **kwargs), shape)
-    k = np.empty((tolerances.samples, *shape), dtype=complex)
-    for i, values in enumerate(tolerances.draws(design)):
-        try:
-            k[i] = stiffness_points(design.replace(**values), f, x, **kwargs)
-        except (ValueError, ArithmeticError) as exc:
-            raise ToleranceError(f"sample {i + 1}: within these tolerances the bushing leaves what the model "
-                                 f"computes: {exc}") from None
+    draws = tolerances.draws(design)
+    try:
+        k = _closed_form_samples(design, draws, f, x, shape, **kwargs)
+    except (ValueError, ArithmeticError) as exc:
+        raise ToleranceError(f"within these tolerances the bushing leaves what the model computes: {exc}") from None
+    if k is None:  # effects, slices or the time-domain route: each sample by the general route
+        k = np.empty((tolerances.samples, *shape), dtype=complex)
+        for i, values in enumerate(draws):
+            try:
+                k[i] = stiffness_points(design.replace(**values), f, x, **kwargs)
+            except (ValueError, ArithmeticError) as exc:
+                raise ToleranceError(f"sample {i + 1}: within these tolerances the bushing leaves what the model "
+                                     f"computes: {exc}") from None
     magnitude, eta = np.abs(k), loss_factor(k)
     q = tolerances.percentiles
     mq, eq = np.percentile(magnitude, q, axis=0), np.percentile(eta, q, axis=0)
@@ -257,6 +264,40 @@ def band(design: Design, frequency_hz, amplitude, tolerances: Tolerances, **kwar
     return Band(tuple(q), dict(zip(q, mq)), dict(zip(q, eq)), np.abs(nominal), loss_factor(nominal),
                 magnitude.std(axis=0), eta.std(axis=0), first[0], first[1], tolerances.samples, tolerances.seed,
                 tolerances.distribution)
+
+
+def _closed_form_samples(design: Design, draws: list[dict[str, float]], f, x, shape, slices=1,
+                         route: str = "analytic") -> np.ndarray | None:
+    """Every sample's K at once, shape (samples, *shape), by eqs 16–18 with arrays of parameters:
+    K = S (µ + m (iω)^α / 2 + µ_f(c x̂)), the numbers :func:`core.bushing.stiffness_points`
+    gives one design at a time. None where that is not the route (effects, slices, the time
+    domain): the caller then computes sample by sample. Raises ValueError for a sample whose
+    geometry the model refuses or whose strain is beyond :data:`core.bushing.MAX_STRAIN`."""
+    if design.effects or slices != 1 or route != "analytic":
+        return None
+    n, ones = len(draws), (1,) * len(shape)
+
+    def column(name: str) -> np.ndarray:
+        if draws and name in draws[0]:
+            return np.array([d[name] for d in draws]).reshape((n, *ones))
+        return np.full((n, *ones), value_of(design, name))
+
+    geometry_varies = any(name in draws[0] for name in GEOMETRY_PARAMETERS) if draws else False
+    if geometry_varies:
+        a, b, length = (column(name).ravel() for name in GEOMETRY_PARAMETERS)
+        pairs = [factors(design.replace(inner_radius=a[i], outer_radius=b[i], length=length[i])) for i in range(n)]
+        s, c = (np.array(v).reshape((n, *ones)) for v in zip(*pairs))
+    else:
+        s, c = (np.full((n, *ones), v) for v in factors(design))
+    strain = c * x
+    if strain.size and float(np.max(strain)) > MAX_STRAIN:
+        raise ValueError(f"a sample's equivalent strain reaches {float(np.max(strain)):.3g}, beyond {MAX_STRAIN:g}")
+    modulus = (column("shear_modulus") + fractional_modulus(f, column("fractional_coefficient"), column("fractional_order"))
+               + friction_modulus(strain, column("friction_stress_max"), column("friction_strain_half")))
+    k = np.broadcast_to(s * modulus, (n, *shape))
+    if not np.all(np.isfinite(k)):
+        raise ValueError("the stiffness of a sample is not finite")
+    return np.array(k)
 
 
 def first_order(design: Design, frequency_hz, amplitude, tolerances: Tolerances, **kwargs):
