@@ -288,6 +288,27 @@ def _unique_keys(pairs):
     return dict(pairs)
 
 
+def strict_json(text: str | bytes, what: str, limit: int) -> Any:
+    """The JSON of an input file (a tolerance or targets file): at most ``limit`` characters, no
+    key given twice, not nested too deeply. Raises ValueError saying which rule ``what`` breaks."""
+    if len(text) > limit:
+        raise ValueError(f"the {what} is larger than {limit} characters ({len(text)})")
+
+    def unique(pairs):
+        keys = [k for k, _ in pairs]
+        repeated = sorted({k for k in keys if keys.count(k) > 1})
+        if repeated:
+            raise ValueError(f"the {what}: {repeated[0]} given twice (name each key once)")
+        return dict(pairs)
+
+    try:
+        return json.loads(text, object_pairs_hook=unique)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"the {what} is not valid JSON: {exc.msg} at line {exc.lineno} column {exc.colno}") from None
+    except RecursionError:
+        raise ValueError(f"the {what} is nested too deeply") from None
+
+
 def loads_design(text: str) -> Design:
     """A design from design-file text: JSON (no key twice, at most :data:`MAX_DESIGN_BYTES`),
     then :func:`design_from_dict`'s rules (which refuse NaN and infinities by their key)."""

@@ -27,7 +27,7 @@ from scipy.optimize import least_squares, minimize
 
 from .bushing import MAX_STRAIN, UNITS, stiffness_points, strain_factor
 from .data import loss_factor
-from .design import MODES, SIZE_RANGE, Design, DesignError, design_from_dict
+from .design import MODES, SIZE_RANGE, Design, DesignError, design_from_dict, strict_json
 from .fit import PARAMETERS as MATERIAL_PARAMETERS
 from .fit import parameter
 
@@ -454,10 +454,8 @@ def problem_from_dict(data: Any) -> Problem:
 
 
 def loads_problem(text: str | bytes) -> Problem:
-    if len(text) > MAX_FILE_BYTES:
-        raise TargetError(f"the targets file is larger than {MAX_FILE_BYTES // 1_000_000} MB")
     try:
-        data = json.loads(text)
-    except (ValueError, RecursionError) as exc:
-        raise TargetError(f"the targets file is not JSON: {exc}") from None
+        data = strict_json(text, "targets file", MAX_FILE_BYTES)
+    except ValueError as exc:
+        raise TargetError(str(exc)) from None
     return problem_from_dict(data)

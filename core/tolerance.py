@@ -19,7 +19,6 @@ covariance.
 
 from __future__ import annotations
 
-import json
 import math
 import re
 from collections.abc import Mapping
@@ -31,7 +30,7 @@ from scipy import stats
 
 from .bushing import MAX_STRAIN, factors, stiffness_points
 from .data import loss_factor
-from .design import Design, DesignError
+from .design import Design, DesignError, strict_json
 from .fit import FitResult, parameter
 from .material import fractional_modulus, friction_modulus
 from .sensitivity import GEOMETRY_PARAMETERS, SENSITIVITY_PARAMETERS, log_derivatives, value_of
@@ -363,12 +362,10 @@ def tolerances_from_dict(data: Any, fit_report: Any = None) -> Tolerances:
 
 
 def loads_tolerances(text: str | bytes, fit_report: Any = None) -> Tolerances:
-    if len(text) > MAX_FILE_BYTES:
-        raise ToleranceError(f"the tolerance file is larger than {MAX_FILE_BYTES // 1000} kB")
     try:
-        data = json.loads(text)
-    except (ValueError, RecursionError) as exc:
-        raise ToleranceError(f"the tolerance file is not JSON: {exc}") from None
+        data = strict_json(text, "tolerance file", MAX_FILE_BYTES)
+    except ValueError as exc:
+        raise ToleranceError(str(exc)) from None
     return tolerances_from_dict(data, fit_report)
 
 

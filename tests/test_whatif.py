@@ -87,7 +87,10 @@ def test_a_fits_covariance_makes_a_band_that_agrees_with_first_order():
     ('{"tolerances": {"length": "1%"}, "fit_covariance": true}', "no fit report"),
     ('{"tolerances": {"length": "1%"}, "colour": 1}', "unknown key"),
     ('[1, 2]', "JSON object"),
-    ('{"tolerances": ', "not JSON"),
+    ('{"tolerances": ', "not valid JSON"),
+    ('{"samples": 10, "samples": 20}', "samples given twice"),
+    ('[' * 40000 + ']' * 40000, "nested too deeply"),
+    ('{"pad": "' + 'x' * 200000 + '"}', "larger than 100000 characters"),
 ])
 def test_bad_tolerances_are_refused_with_their_reason(text, match):
     with pytest.raises(ToleranceError, match=match):
@@ -291,3 +294,15 @@ def test_the_vectorised_band_is_the_sample_by_sample_one(mode):
         np.testing.assert_allclose(fast.magnitude[q], slow.magnitude[q], rtol=1e-12)
         np.testing.assert_allclose(fast.loss_factor[q], slow.loss_factor[q], rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(fast.std_magnitude, slow.std_magnitude, rtol=1e-9)
+
+
+@pytest.mark.parametrize("text, match", [
+    ('{"solutions": 1, "solutions": 2}', "solutions given twice"),
+    ('{"design": ', "not valid JSON"),
+    ('[' * 40000 + ']' * 40000, "nested too deeply"),
+])
+def test_a_targets_file_is_strict_json(text, match):
+    from core.target import loads_problem
+
+    with pytest.raises(TargetError, match=match):
+        loads_problem(text)
