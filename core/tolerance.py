@@ -19,6 +19,7 @@ covariance.
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from collections.abc import Mapping
@@ -28,9 +29,9 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from .bushing import MAX_STRAIN, factors, stiffness_points
+from .bushing import MAX_STRAIN, factors, shape_factor, stiffness_points, strain_factor
 from .data import loss_factor
-from .design import Design, DesignError, strict_json
+from .design import Design, DesignError, Geometry, strict_json
 from .fit import FitResult, parameter
 from .material import fractional_modulus, friction_modulus
 from .sensitivity import GEOMETRY_PARAMETERS, SENSITIVITY_PARAMETERS, log_derivatives, value_of
@@ -283,9 +284,8 @@ def _closed_form_samples(design: Design, draws: list[dict[str, float]], f, x, sh
 
     geometry_varies = any(name in draws[0] for name in GEOMETRY_PARAMETERS) if draws else False
     if geometry_varies:
-        a, b, length = (column(name).ravel() for name in GEOMETRY_PARAMETERS)
-        pairs = [factors(design.replace(inner_radius=a[i], outer_radius=b[i], length=length[i])) for i in range(n)]
-        s, c = (np.array(v).reshape((n, *ones)) for v in zip(*pairs))
+        s, c = (v.reshape((n, *ones)) for v in _sample_factors(design, tuple(
+            tuple(d.get(name, value_of(design, name)) for name in GEOMETRY_PARAMETERS) for d in draws)))
     else:
         s, c = (np.full((n, *ones), v) for v in factors(design))
     strain = c * x
@@ -297,6 +297,18 @@ def _closed_form_samples(design: Design, draws: list[dict[str, float]], f, x, sh
     if not np.all(np.isfinite(k)):
         raise ValueError("the stiffness of a sample is not finite")
     return np.array(k)
+
+
+@functools.lru_cache(maxsize=8)
+def _sample_factors(design: Design, geometries: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """The shape and strain factors (S, c) of each sampled geometry (a, b, L) in the design's
+    mode and shape: kept for the next band of the same draws (an explorer view draws three)."""
+    pairs = []
+    for a, b, length in geometries:
+        g = Geometry(a, b, length)
+        pairs.append((shape_factor(g, design.mode, design.shape), strain_factor(g, design.mode, design.shape)))
+    s, c = zip(*pairs)
+    return np.array(s), np.array(c)
 
 
 def first_order(design: Design, frequency_hz, amplitude, tolerances: Tolerances, **kwargs):
