@@ -284,7 +284,7 @@ def _closed_form_samples(design: Design, draws: list[dict[str, float]], f, x, sh
 
     geometry_varies = any(name in draws[0] for name in GEOMETRY_PARAMETERS) if draws else False
     if geometry_varies:
-        s, c = (v.reshape((n, *ones)) for v in _sample_factors(design, tuple(
+        s, c = (v.reshape((n, *ones)) for v in _sample_factors(design.mode, design.shape, tuple(
             tuple(d.get(name, value_of(design, name)) for name in GEOMETRY_PARAMETERS) for d in draws)))
     else:
         s, c = (np.full((n, *ones), v) for v in factors(design))
@@ -300,13 +300,14 @@ def _closed_form_samples(design: Design, draws: list[dict[str, float]], f, x, sh
 
 
 @functools.lru_cache(maxsize=8)
-def _sample_factors(design: Design, geometries: tuple) -> tuple[np.ndarray, np.ndarray]:
-    """The shape and strain factors (S, c) of each sampled geometry (a, b, L) in the design's
-    mode and shape: kept for the next band of the same draws (an explorer view draws three)."""
+def _sample_factors(mode: str, shape: str | None, geometries: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """The shape and strain factors (S, c) of each sampled geometry (a, b, L) in ``mode`` and
+    ``shape``: kept for the next band of the same draws (an explorer view draws three, and a
+    change of the material leaves them as they are)."""
     pairs = []
     for a, b, length in geometries:
         g = Geometry(a, b, length)
-        pairs.append((shape_factor(g, design.mode, design.shape), strain_factor(g, design.mode, design.shape)))
+        pairs.append((shape_factor(g, mode, shape), strain_factor(g, mode, shape)))
     s, c = zip(*pairs)
     return np.array(s), np.array(c)
 
