@@ -11,7 +11,7 @@ from core.card import card, card_design, ratios
 from core.shape import long_shape_factor
 
 from . import plots, units
-from .curves import card_sweeps, padded
+from .curves import card_bands, card_sweeps, padded
 from .explorer import BAND_PARAMETERS
 from .live import LivePlot
 from .state import ExplorerState
@@ -58,21 +58,19 @@ class CardView(PlotView):
         x, angle = self.displacement_mm * 1e-3, self.angle_rad
         try:
             rows = card(design, f, x, angle)
-            data = card_sweeps(design, f, tolerances=self.state.checked_tolerances())
+            data = card_sweeps(design, f)
         except ValueError as exc:  # outside the finite-length table, or an effect with no card
             self.table.object = f"_The card is not available for this design: {exc}_"
             return
+        for mode, b in (self.state.banded(lambda tol: card_bands(design, f, tol)) or {}).items():
+            data[mode].update(b)
         self.table.object = self.summary(design, f, rows)
         for which, modes in (("translation", ("axial", "radial")), ("rotation", ("torsion", "conical"))):
             dim = self.dims["displacement" if which == "translation" else "angle"]
             dim.range = padded([data[m]["amplitude"] for m in modes], log=True)
         at = {"translation": units.display_amplitude(x, "axial"), "rotation": units.display_amplitude(angle, "torsion")}
         overlays = plots.card_overlays(data, self.dims, at)
-        items = [overlays[w] for w in WHICH]
-        if self.plots is None:
-            self.plots = LivePlot(items)
-        else:
-            self.plots.show(items)
+        self.plots = LivePlot.shown(self.plots, [overlays[w] for w in WHICH])
 
     @staticmethod
     def summary(design, frequency_hz, rows) -> str:

@@ -284,10 +284,10 @@ def operating_bands(design: Design, frequency_hz: float, amplitude: float, f, x,
 def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq_range=(1.0, 100.0),
                   reference: Design | None = None, measured: MeasuredStiffness | None = None,
                   measured_loop: MeasuredLoop | None = None, n_freq: int = 120, n_amp: int = 120,
-                  tolerances=None, band_cache: dict | None = None) -> ExplorerData:
+                  bands: dict | None = None) -> ExplorerData:
     """The explorer's curves at the operating point (``frequency_hz``, ``amplitude`` in display
-    units). A reference in another mode than ``design`` is left out. With ``tolerances``
-    (:class:`core.tolerance.Tolerances`), the operating curves' bands (:func:`operating_bands`)."""
+    units). A reference in another mode than ``design`` is left out. ``bands``: the operating
+    curves' tolerance bands on the same grids (:func:`operating_bands`), if any."""
     mode = design.mode
     f = np.linspace(*freq_range, n_freq)
     x = amplitude_grid(design, n_amp)
@@ -302,8 +302,6 @@ def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq
     lp = hysteresis_loop(design, frequency_hz, amplitude)
     ref_loop = hysteresis_loop(ref, frequency_hz, amplitude) if ref is not None else None
     loop_points = measured_loop_points(measured_loop, mode)
-    bands = (operating_bands(design, frequency_hz, amplitude, f, x, tolerances, band_cache)
-             if tolerances is not None else None)
     ranges = {"frequency": padded([f]), "amplitude": padded([x], log=True)}
     for quantity in ("magnitude", "loss_factor"):
         parts = [s[quantity] for s in sweeps.values()] + [s[quantity] for s in operating.values()]
@@ -364,29 +362,43 @@ def curve_groups(r, most: int = 5) -> list[dict]:
     return groups
 
 
-def card_sweeps(design: Design, frequency_hz: float, strains=None, tolerances=None) -> dict:
+def card_sweeps(design: Design, frequency_hz: float, strains=None) -> dict:
     """The bushing card's curves (:mod:`core.card`): for each direction, the drive amplitude in
     display units, |K| in display units and the loss factor at ``frequency_hz``, over a grid of
-    equivalent strains (the same grid for every direction, so the loss factors share an axis).
-    With ``tolerances``, each direction's band too (``magnitude_band``, ``loss_factor_band``:
-    (low, high) at the first and last percentiles), at the drives of the nominal design."""
-    from core.card import CARD_MODES, card_design
+    equivalent strains (the same grid for every direction, so the loss factors share an axis)."""
+    out = {"strain": _card_strains(strains)}
+    for mode, d, drive in _card_directions(design, out["strain"]):
+        k = stiffness_points(d, frequency_hz, drive)
+        out[mode] = {"amplitude": units.display_amplitude(drive, mode),
+                     "magnitude": units.display_stiffness(np.abs(k), mode), "loss_factor": loss_factor(k)}
+    return out
+
+
+def card_bands(design: Design, frequency_hz: float, tolerances, strains=None) -> dict:
+    """Each direction's tolerance band along :func:`card_sweeps`' curves: ``magnitude_band`` and
+    ``loss_factor_band``, (low, high) at the first and last percentiles (display units)."""
     from core.tolerance import band
 
-    eps = np.geomspace(1e-5, 1e-1, 60) if strains is None else np.asarray(strains, dtype=float)
-    out = {"strain": eps}
+    out = {}
+    for mode, d, drive in _card_directions(design, _card_strains(strains)):
+        b = band(d, frequency_hz, drive, tolerances)
+        low, high = min(b.percentiles), max(b.percentiles)
+        out[mode] = {"magnitude_band": tuple(units.display_stiffness(b.magnitude[q], mode) for q in (low, high)),
+                     "loss_factor_band": (b.loss_factor[low], b.loss_factor[high])}
+    return out
+
+
+def _card_strains(strains) -> np.ndarray:
+    return np.geomspace(1e-5, 1e-1, 60) if strains is None else np.asarray(strains, dtype=float)
+
+
+def _card_directions(design: Design, strains: np.ndarray):
+    """(mode, the card's design in that direction, the drives at ``strains``) of every direction."""
+    from core.card import CARD_MODES, card_design
+
     for mode in CARD_MODES:
         d = card_design(material_model(design), mode)
-        c = strain_factor(d.geometry, mode, d.shape)
-        k = stiffness_points(d, frequency_hz, eps / c)
-        out[mode] = {"amplitude": units.display_amplitude(eps / c, mode),
-                     "magnitude": units.display_stiffness(np.abs(k), mode), "loss_factor": loss_factor(k)}
-        if tolerances is not None:
-            b = band(d, frequency_hz, eps / c, tolerances)
-            low, high = min(b.percentiles), max(b.percentiles)
-            out[mode]["magnitude_band"] = tuple(units.display_stiffness(b.magnitude[q], mode) for q in (low, high))
-            out[mode]["loss_factor_band"] = (b.loss_factor[low], b.loss_factor[high])
-    return out
+        yield mode, d, strains / strain_factor(d.geometry, mode, d.shape)
 
 
 def prediction_misfit(fit, measured: MeasuredStiffness | None) -> dict | None:

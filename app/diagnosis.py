@@ -40,15 +40,6 @@ def _effect_card(eid: str) -> str:
     return f"**{e.title}** (`{eid}`). {e.physics} *Signature in data:* {e.signature}"
 
 
-def fitted_name(step, parameter: str, r) -> str:
-    """A step's parameter by its name in the final fit (``inertia@torsion.mass`` for a mass on
-    another mode's rig than the design's)."""
-    effect = EFFECTS[step.effect]
-    if step.mode and step.mode != r.final.design.mode:
-        return f"{step.effect}@{step.mode}.{parameter}"
-    return effect.fitting_name(parameter)
-
-
 class DiagnosisView(pn.viewable.Viewer):
     """Data → baseline → diagnosis → the final model in the explorer."""
 
@@ -180,11 +171,10 @@ class DiagnosisView(pn.viewable.Viewer):
             f"**Baseline** ({branches}): gap **{r.baseline.gap:.4f}**; the noise alone gives about {noise}.",
             f"*Where it disagrees:* {r.where_baseline}",
         ]
-        vague = set(r.final.fit.undetermined)
         for n, step in enumerate(r.steps, 1):
             params = ", ".join(f"{k} = {v:.4g}" + (f" ± {step.standard_errors[k]:.2g}"
                                                    if np.isfinite(step.standard_errors.get(k, np.nan)) else
-                                                   " (not determined)" if fitted_name(step, k, r) in vague else "")
+                                                   " (not determined)" if k in step.undetermined else "")
                                for k, v in step.parameters.items()) or "no parameters"
             partner = step.extra.get("found_with")
             together = f" (found together with {partner})" if partner else ""

@@ -118,6 +118,15 @@ class LivePlot:
         """The overlays shown now."""
         return self.pipe.data
 
+    @classmethod
+    def shown(cls, live: LivePlot | None, overlays: list, **kwargs) -> LivePlot:
+        """``live`` showing ``overlays``, or a new LivePlot of them (``kwargs`` as the
+        constructor's) the first time."""
+        if live is None:
+            return cls(overlays, **kwargs)
+        live.show(overlays)
+        return live
+
     def show(self, overlays: list):
         """Show ``overlays`` (as many as there are plots)."""
         overlays = list(overlays)

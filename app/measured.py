@@ -148,10 +148,7 @@ class MeasuredView(PlotView):
             self.dims["residual_loss"].range = padded([residuals["loss_factor_residual"]])
         overlays = plots.residual_overlays(points, residuals, self.dims)
         items = [overlays[k] for k in RESIDUALS]
-        if self.residuals is None:
-            self.residuals = LivePlot(items)
-        else:
-            self.residuals.show(items)
+        self.residuals = LivePlot.shown(self.residuals, items)
 
     @staticmethod
     def _results_table(r):

@@ -40,10 +40,7 @@ class SlicesView(PlotView):
         self.dims["amplitude"].range = padded([data["amplitude"]], log=True)
         overlays = plots.slices_overlays(data, self.dims, self.state.amplitude)
         items = [overlays[w] for w in WHICH]
-        if self.plots is None:
-            self.plots = LivePlot(items, taps={i: self.tap_amplitude for i in range(len(WHICH))})
-        else:
-            self.plots.show(items)
+        self.plots = LivePlot.shown(self.plots, items, taps={i: self.tap_amplitude for i in range(len(WHICH))})
         self.table.object = self.summary(data)
 
     def summary(self, data):

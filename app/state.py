@@ -501,11 +501,11 @@ class ExplorerState(param.Parameterized):
                          covariance=covariance)
         if not tol.varied:
             raise ToleranceError("every tolerance is 0: give one (± %) to see a band")
-        tol.check(self.design)
         return tol
 
     def checked_tolerances(self) -> Tolerances | None:
-        """:meth:`tolerances`, or None with the reason in :attr:`band_message`."""
+        """:meth:`tolerances`, or None with the reason in :attr:`band_message` (a band computed
+        with them may still say why it cannot be: :meth:`banded`)."""
         try:
             tol = self.tolerances()
         except ToleranceError as exc:
@@ -514,19 +514,26 @@ class ExplorerState(param.Parameterized):
         self.band_message = ""
         return tol
 
+    def banded(self, compute):
+        """``compute(tolerances)`` with the tolerances of the bands, or None when there are none
+        or a sample cannot be computed (the reason in :attr:`band_message`)."""
+        tolerances = self.checked_tolerances()
+        if tolerances is None:
+            return None
+        try:
+            return compute(tolerances)
+        except ToleranceError as exc:  # e.g. a sample outside the finite-length table
+            self.band_message = str(exc)
+            return None
+
     def explorer_data(self):
         """Everything the explorer's five plots show (:func:`app.curves.explorer_data`)."""
-        tolerances = self.checked_tolerances()
-        try:
-            return curves.explorer_data(self.design, self.frequency_hz, self.amplitude, freq_range=self.freq_range,
-                                        reference=self.reference, measured=self.measured,
-                                        measured_loop=self.measured_loop, tolerances=tolerances,
-                                        band_cache=self._band_cache)
-        except ToleranceError as exc:  # a sample the model cannot compute: the plots without the band
-            self.band_message = str(exc)
-            return curves.explorer_data(self.design, self.frequency_hz, self.amplitude, freq_range=self.freq_range,
-                                        reference=self.reference, measured=self.measured,
-                                        measured_loop=self.measured_loop)
+        bands = self.banded(lambda tol: curves.operating_bands(
+            self.design, self.frequency_hz, self.amplitude, self.frequency_grid(), self.amplitude_grid(), tol,
+            self._band_cache))
+        return curves.explorer_data(self.design, self.frequency_hz, self.amplitude, freq_range=self.freq_range,
+                                    reference=self.reference, measured=self.measured,
+                                    measured_loop=self.measured_loop, bands=bands)
 
     def comparison(self) -> dict | None:
         """Current design against the pinned reference, in %, at the operating point and over
@@ -564,13 +571,8 @@ class ExplorerState(param.Parameterized):
         columns too (those of ``bushing stiffness --tolerance``)."""
         f, x = self.frequency_grid(n_freq), self._si_amplitude(self.amplitude_grid(n_amp))
         table = stiffness(self.design, f, x).table()
-        tolerances = self.checked_tolerances()
-        if tolerances is not None:
-            try:
-                table.update(band_columns(band(self.design, f[None, :], np.asarray(x)[:, None], tolerances)))
-            except ToleranceError as exc:
-                self.band_message = str(exc)
-        return table
+        columns = self.banded(lambda tol: band_columns(band(self.design, f[None, :], np.asarray(x)[:, None], tol)))
+        return {**table, **(columns or {})}
 
 
 def _match_shown(design: Design, known) -> Design:

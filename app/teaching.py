@@ -64,10 +64,7 @@ class TeachingView(PlotView):
         self.dims["branch_loss"].range = padded([np.zeros(1), totals["loss"]])
         overlays = plots.branch_overlays(d, self.dims, self.state.amplitude)
         items = [overlays[w] for w in WHICH]
-        if self.branches is None:
-            self.branches = LivePlot(items, taps={0: self.tap_amplitude, 1: self.tap_amplitude})
-        else:
-            self.branches.show(items)
+        self.branches = LivePlot.shown(self.branches, items, taps={0: self.tap_amplitude, 1: self.tap_amplitude})
         self._draw_frame()
 
     def _frame(self):
@@ -76,10 +73,7 @@ class TeachingView(PlotView):
     def _draw_frame(self):
         x = np.geomspace(*self.state.amplitude_bounds, self.FRAMES)[self.player.value]
         shape = plots.loop_shape_overlay(self.state.hysteresis_loop(amplitude=x), self.dims)
-        if self.loop is None:
-            self.loop = LivePlot([shape])
-        else:
-            self.loop.show([shape])
+        self.loop = LivePlot.shown(self.loop, [shape])
         self.frame_label.object = (f'<span class="frame-point">Loop shape at <b>{x:.3g} '
                                    f"{self.state.amplitude_unit}</b>, {self.state.frequency_hz:.3g} Hz</span>")
 

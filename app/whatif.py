@@ -158,10 +158,7 @@ class WhatIfView(PlotView):
             title = "|K|: % per +1 % of the parameter" if quantity == "magnitude" else \
                 "Loss factor: change per unit ln p"
             items.append(plots.sensitivity_bars(bars, title, color, f"bushing-sensitivity-{quantity.replace('_', '-')}"))
-        if self.bars is None:
-            self.bars = LivePlot(items)
-        else:
-            self.bars.show(items)
+        self.bars = LivePlot.shown(self.bars, items)
         s = self.state
         self.sentence.object = (f"At {s.frequency_hz:.3g} Hz and {s.amplitude:.3g} {s.amplitude_unit}: "
                                 f"{sentence(values)}")

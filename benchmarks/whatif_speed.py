@@ -54,7 +54,7 @@ def main():
     line(f"every sweep curve of the explorer ({grid_f.size} points)",
          median_ms(fresh(lambda: band(PAPER_B, grid_f, grid_x, TOL))), 300)
     line("the card: 4 directions × 60 amplitudes",
-         median_ms(fresh(lambda: curves.card_sweeps(PAPER_B, 10.0, tolerances=TOL))), 300)
+         median_ms(fresh(lambda: curves.card_bands(PAPER_B, 10.0, TOL))), 300)
     from app.main import App
 
     app = App()

@@ -65,8 +65,11 @@ class Target:
     def is_ratio(self) -> bool:
         return len(self.modes) == 2
 
-    def measure(self, design: Design) -> float:
-        k = [complex(stiffness_points(design.in_mode(m), self.frequency_hz, x)) for m, x in zip(self.modes, self.amplitudes)]
+    def measure(self, design: Design, directions: dict[str, Design] | None = None) -> float:
+        """The target's quantity for ``design``; ``directions``: the design already taken into
+        each mode (:meth:`core.design.Design.in_mode`), where the caller has them."""
+        directions = directions or {m: design.in_mode(m) for m in self.modes}
+        k = [complex(stiffness_points(directions[m], self.frequency_hz, x)) for m, x in zip(self.modes, self.amplitudes)]
         if self.is_ratio:
             return abs(k[0]) / abs(k[1])
         return abs(k[0]) if self.quantity == "magnitude" else float(loss_factor(k[0]))
@@ -188,11 +191,13 @@ class _Evaluator:
             design = p.design(z)
             b = design.geometry.outer_radius
             ineq += [math.log(b / p.limits["outer_radius"][0]), math.log(p.limits["outer_radius"][1] / b)]
+            directions = {m: design.in_mode(m) for t in p.targets for m in t.modes}  # once per point
             for t in p.targets:
                 for m, x in zip(t.modes, t.amplitudes):
-                    ineq.append(math.log(MAX_STRAIN / (strain_factor(design.geometry, m, design.in_mode(m).shape) * x)))
+                    d = directions[m]
+                    ineq.append(math.log(MAX_STRAIN / (strain_factor(d.geometry, m, d.shape) * x)))
             for t in p.targets:
-                q = t.measure(design)
+                q = t.measure(design, directions)
                 lq = math.log(q) if q > 0 else -50.0
                 if self.exact and t.value is not None:
                     eq.append(lq - math.log(t.value))

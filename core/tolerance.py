@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy import stats
+from scipy import linalg, stats
 
 from .bushing import MAX_STRAIN, factors, shape_factor, stiffness_points, strain_factor
 from .data import loss_factor
@@ -63,7 +63,7 @@ class FitCovariance:
 
     @classmethod
     def of(cls, result: FitResult) -> FitCovariance:
-        return cls(dict(result.report()["standard_errors"]), result.report()["correlation"])
+        return cls.from_report(result.report())
 
     @classmethod
     def from_report(cls, report: Any) -> FitCovariance:
@@ -192,9 +192,10 @@ class Tolerances:
                 out[name] = np.exp(theta[:, j]) if parameter(name).log else np.clip(theta[:, j], max(lo, 1e-3), hi)
         return [{name: float(v[i]) for name, v in out.items()} for i in range(n)]
 
-    def covariance_of_draws(self, design: Design) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
-        """The names, the covariance of the draws in ln p (for first-order propagation), and the
-        scale that takes a fit's coordinate θ to ln p (1 for log-fitted, 1/p for α)."""
+    def covariance_of_draws(self, design: Design) -> tuple[tuple[str, ...], np.ndarray]:
+        """The names and the covariance of the draws in ln p (for first-order propagation): the
+        tolerances' independent variances, then the fit's block (its coordinate θ is ln p, or α
+        itself, whose ln-scale is 1/α)."""
         names, sd = [], []
         for name, width in sorted(self.half_widths(design).items()):
             names.append(name)
@@ -205,12 +206,7 @@ class Tolerances:
             to_log = np.array([1.0 if parameter(n).log else 1.0 / value_of(design, n) for n in fit_names])
             names += list(fit_names)
             blocks.append(cov * np.outer(to_log, to_log))
-        size = sum(b.shape[0] for b in blocks)
-        full, at = np.zeros((size, size)), 0
-        for b in blocks:
-            full[at:at + b.shape[0], at:at + b.shape[0]] = b
-            at += b.shape[0]
-        return tuple(names), full, to_log if self.covariance is not None else np.ones(0)
+        return tuple(names), linalg.block_diag(*blocks)
 
 
 @dataclass(frozen=True)
@@ -315,7 +311,7 @@ def _sample_factors(mode: str, shape: str | None, geometries: tuple) -> tuple[np
 def first_order(design: Design, frequency_hz, amplitude, tolerances: Tolerances, **kwargs):
     """The standard deviations of |K| and η by first-order propagation, σ² = g Σ gᵀ (g the
     derivatives in ln p, Σ the draws' covariance in ln p)."""
-    names, cov, _ = tolerances.covariance_of_draws(design)
+    names, cov = tolerances.covariance_of_draws(design)
     shape = np.broadcast_shapes(np.shape(frequency_hz), np.shape(amplitude))
     if not names:
         return np.zeros(shape), np.zeros(shape)

@@ -136,3 +136,14 @@ def test_tolerances_travel_in_a_link(app):
     assert "Tolerance band" in app.plots.summary.object
     app.state.tolerance_text = "mu:lots"  # a hand-edited link: said, and no band
     assert "key:percent pairs" in app.state.band_message and "No tolerance band" in app.plots.summary.object
+
+
+def test_a_band_that_leaves_the_table_keeps_the_card_and_says_why(app):
+    """b ±40 % takes some samples outside the finite-length table: the card is still drawn
+    (without bands), and the message says why there is no band."""
+    app.state.tolerance_pct = {"outer_radius": 40.0}
+    app.state.band_on = True
+    app.tabs.active = [t for t, *_ in App.LAZY_TABS].index("Every direction") + 1
+    assert "At 10 Hz" in app.card.table.object and "not available" not in app.card.table.object
+    assert "finite-length shape factors cover" in app.state.band_message
+    assert all("band" not in (e.label or "") for e in app.card.frame("translation"))

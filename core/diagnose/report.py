@@ -53,6 +53,7 @@ class Step:
     standard_errors: dict[str, float] = field(default_factory=dict)  # of ``parameters``, linearised
     mode: str | None = None  # data of several modes: the rig a rig effect (a mass) was found on
     by_mode: dict = field(default_factory=dict)  # data of several modes: each mode's evidence
+    undetermined: tuple[str, ...] = ()  # of ``parameters``, those the final model's profile leaves open
 
     @property
     def supported_by(self) -> list[str]:

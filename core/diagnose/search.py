@@ -225,10 +225,20 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
     if not accepted:
         first = current
     remaining = noise is not None and current.mean_square > NOISE_RATIO * noise
+    # the report's gaps are over every measured point: a model fitted to bins is evaluated there
+    every: dict[int, Fitted] = {}
+
+    def on(fitted: Fitted) -> Fitted:
+        if data is measured:
+            return fitted
+        if id(fitted) not in every:
+            every[id(fitted)] = _on(measured, fitted)
+        return every[id(fitted)]
+
     disagreement = {}
     if modes:
         say(0.82, "weighing one material for every mode against one per mode")
-        disagreement = _disagreement(current, data, measured, remaining)
+        disagreement = _disagreement(current, data, measured, on(current), remaining)
 
     # the words, with the final noise estimate: each misfit described once
     sd = math.sqrt((noise or current.mean_square) / 2.0)
@@ -246,30 +256,21 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
         names = dict(zip((p.name for p in effect.parameters), fitting_names(a.effect)))
         params = {p: values[n] for p, n in names.items()}
         # a parameter the final profile finds undetermined has no standard error worth quoting
-        errors = {p: math.nan if n in current.fit.undetermined else a.values_from.fit.standard_errors.get(n, math.nan)
+        vague = tuple(p for p, n in names.items() if n in current.fit.undetermined)
+        errors = {p: math.nan if p in vague else a.values_from.fit.standard_errors.get(n, math.nan)
                   for p, n in names.items()}
         rig_mode = (split_id(a.effect)[1] or design.mode) if modes and effect.rig else None
+        support = _support(a.before, a.after, data, on(a.before), on(a.after)) if modes else {}
         steps.append(Step(effect.id, effect.title, where(a.before), a.before.bic - a.after.bic,
-                          explains(a.before, a.after, noise)[1], params, a.before.gap, a.after.gap, a.drops,
-                          a.evidence, errors, rig_mode,
-                          _support(a.before, a.after, data, measured) if modes else {}))
+                          explains(a.before, a.after, noise)[1], params, on(a.before).gap, on(a.after).gap, a.drops,
+                          a.evidence, errors, rig_mode, support, vague))
     held = {}
     if held_out:
         say(0.85, "checking on held-out data")
         held = _held_out(measured, {"baseline": first, "final": current})
     say(1.0, "done")
     where_first, where_final = where(first), where(current) if remaining else "no misfit above the noise."
-    if data is not measured:  # the report's gaps and predictions are over every measured point
-        every: dict[int, Fitted] = {}
-
-        def on(fitted: Fitted) -> Fitted:
-            if id(fitted) not in every:
-                every[id(fitted)] = _on(measured, fitted)
-            return every[id(fitted)]
-
-        steps = [replace(s, gap_before=on(a.before).gap, gap_after=on(a.after).gap) for s, a in zip(steps, accepted)]
-        first, current = on(first), on(current)
-    return Diagnosis(measured, first, steps, current, noise, remaining, where_first, where_final, held,
+    return Diagnosis(measured, on(first), steps, on(current), noise, remaining, where_first, where_final, held,
                      disagreement)
 
 
@@ -292,12 +293,14 @@ def _mode_misfit(residual: np.ndarray, rows: np.ndarray) -> float:
     return n * math.log(max(float(np.sum(np.abs(residual[rows]) ** 2)) / n, PRECISION**2))
 
 
-def _support(before: Fitted, after: Fitted, data: MeasuredStiffness, measured: MeasuredStiffness) -> dict:
-    """Each mode's share of a step's evidence: the drop of its own misfit term n ln(RSS/n)
-    (the BIC drop's data part) and its gap before and after, over every measured point. A mode
-    *supports* the step when its drop exceeds :data:`BIC_THRESHOLD`, is *against* it when its
-    misfit grows by as much, and is *neutral* otherwise (its data do not see the effect)."""
-    gaps = [gaps_by_mode(model_stiffness(f.design, measured), measured) for f in (before, after)]
+def _support(before: Fitted, after: Fitted, data: MeasuredStiffness, before_measured: Fitted,
+             after_measured: Fitted) -> dict:
+    """Each mode's share of a step's evidence: the drop of its own misfit term n ln(RSS/n) over
+    ``data`` (the BIC drop's data part) and its gap before and after over every measured point
+    (``*_measured``: the same models there). A mode *supports* the step when its drop exceeds
+    :data:`BIC_THRESHOLD`, is *against* it when its misfit grows by as much, and is *neutral*
+    otherwise (its data do not see the effect)."""
+    gaps = [f.fit.gap_by_mode for f in (before_measured, after_measured)]
     out = {}
     for m in np.unique(data.mode.astype(str)):
         rows = data.mode == m
@@ -307,7 +310,8 @@ def _support(before: Fitted, after: Fitted, data: MeasuredStiffness, measured: M
     return out
 
 
-def _disagreement(current: Fitted, data: MeasuredStiffness, measured: MeasuredStiffness, remaining: bool) -> dict:
+def _disagreement(current: Fitted, data: MeasuredStiffness, measured: MeasuredStiffness, current_measured: Fitted,
+                  remaining: bool) -> dict:
     """One material for every mode (``current``, fitted jointly) weighed against one per mode:
     the final model refitted to each mode's data alone, its parameters that act there free.
     The modes *disagree* when the BIC drops by more than :data:`BIC_THRESHOLD` for the extra
@@ -329,13 +333,13 @@ def _disagreement(current: Fitted, data: MeasuredStiffness, measured: MeasuredSt
     n = 2 * len(data)
     separate = n * math.log(max(rss / n, PRECISION**2)) + count * math.log(n)
     drop = current.bic - separate
-    joint = gaps_by_mode(model_stiffness(current.design, measured), measured)
     return {"disagree": bool(remaining and drop > BIC_THRESHOLD), "bic_drop": drop,
-            "gap_joint_by_mode": joint, "gap_alone_by_mode": alone, "parameters_alone": values}
+            "gap_joint_by_mode": current_measured.fit.gap_by_mode, "gap_alone_by_mode": alone,
+            "parameters_alone": values}
 
 
 def _on(data: MeasuredStiffness, fitted: Fitted) -> Fitted:
     """``fitted`` (fitted to binned data) evaluated at every point of ``data``."""
     k = model_stiffness(fitted.design, data)
-    fit = replace(fitted.fit, gap=gap(k, data.stiffness), points=len(data))
+    fit = replace(fitted.fit, gap=gap(k, data.stiffness), gap_by_mode=gaps_by_mode(k, data), points=len(data))
     return Fitted(fitted.model, fit, k, relative_residual(k, data.stiffness), fitted.bic)
