@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import math
 import re
 import sys
@@ -21,7 +20,7 @@ import numpy as np
 
 from .bushing import MAX_SLICES, loop, slice_count, stiffness
 from .data import MAX_ROWS, DataError, csv_text
-from .design import DesignError, read_design
+from .design import DesignError, read_design, read_design_file
 from .material import ConvergenceError
 
 NUMBER_FORMAT = "{:.12g}"
@@ -274,7 +273,7 @@ def _cmd_stiffness(args) -> None:
     if freqs.size * len(args.amp) > MAX_GRID:
         raise InputError(f"bushing stiffness: {freqs.size} frequencies × {len(args.amp)} amplitudes is more "
                          f"than {MAX_GRID} points; ask for fewer")
-    design = read_design(args.design)
+    design, fit_report = read_design_file(args.design)
     slices = "continuum" if args.continuum else args.slices
     layers = slice_count(design, slices)
     work, limit = freqs.size * len(args.amp) * layers, MAX_SLICE_POINTS[args.route]
@@ -289,7 +288,7 @@ def _cmd_stiffness(args) -> None:
     if args.tolerance:
         from .tolerance import band, band_columns
 
-        tolerances = _read_tolerances(args.tolerance, args.design)
+        tolerances = _read_tolerances(args.tolerance, fit_report)
         if work * tolerances.samples > limit:
             raise InputError(f"bushing stiffness: {tolerances.samples} samples × {work} point-layers is more than "
                              f"{limit} for the {args.route} route; ask for fewer samples or points")
@@ -298,16 +297,12 @@ def _cmd_stiffness(args) -> None:
     _write_csv(_finite(table), args.output)
 
 
-def _read_tolerances(path: str, design_path: str):
-    """The tolerance file, with the design file's fit report when it asks for the fit's covariance."""
+def _read_tolerances(path: str, fit_report: dict | None):
+    """The tolerance file, with the design file's fit report for when it asks for the fit's
+    covariance."""
     from .tolerance import MAX_FILE_BYTES, loads_tolerances
 
-    text = _small_text(path, "tolerance", MAX_FILE_BYTES)
-    try:
-        report = json.loads(Path(design_path).read_text(encoding="utf-8-sig")).get("fit")
-    except (OSError, ValueError, AttributeError):
-        report = None  # read_design has already accepted the file: a fit report is just absent
-    return loads_tolerances(text, report)
+    return loads_tolerances(_small_text(path, "tolerance", MAX_FILE_BYTES), fit_report)
 
 
 def _small_text(path: str, what: str, limit: int) -> str:

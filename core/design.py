@@ -312,6 +312,12 @@ def strict_json(text: str | bytes, what: str, limit: int) -> Any:
 def loads_design(text: str) -> Design:
     """A design from design-file text: JSON (no key twice, at most :data:`MAX_DESIGN_BYTES`),
     then :func:`design_from_dict`'s rules (which refuse NaN and infinities by their key)."""
+    return loads_design_file(text)[0]
+
+
+def loads_design_file(text: str) -> tuple[Design, dict | None]:
+    """:func:`loads_design`, and the file's ``fit`` object (the report of ``bushing fit``) if it
+    has one."""
     if len(text) > MAX_DESIGN_BYTES:
         raise DesignError("", f"too large for a design file ({len(text)} characters; at most {MAX_DESIGN_BYTES})")
     try:
@@ -320,10 +326,15 @@ def loads_design(text: str) -> Design:
         raise DesignError("", f"not valid JSON: {exc.msg} at line {exc.lineno} column {exc.colno}")
     except RecursionError:
         raise DesignError("", "not a design file: nested too deeply") from None
-    return design_from_dict(data)
+    return design_from_dict(data), (data.get("fit") if isinstance(data, Mapping) else None)
 
 
 def read_design(path: str | Path) -> Design:
+    return read_design_file(path)[0]
+
+
+def read_design_file(path: str | Path) -> tuple[Design, dict | None]:
+    """A design file read once: the design and its ``fit`` object, if any."""
     path = Path(path)
     try:
         if path.stat().st_size > MAX_DESIGN_BYTES:
@@ -335,7 +346,7 @@ def read_design(path: str | Path) -> Design:
     except UnicodeDecodeError:
         raise DesignError("", f"design file {str(path)!r} is not UTF-8 text")
     try:
-        return loads_design(text)
+        return loads_design_file(text)
     except DesignError as exc:
         raise DesignError(exc.key, f"{exc.rule} (in {path.name})") from None
 

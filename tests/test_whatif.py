@@ -306,3 +306,23 @@ def test_a_targets_file_is_strict_json(text, match):
 
     with pytest.raises(TargetError, match=match):
         loads_problem(text)
+
+
+def test_the_command_line_draws_the_material_from_a_fitted_design_file(tmp_path):
+    """`bushing fit -o fitted.json`, then `stiffness --tolerance` with fit_covariance: the
+    band is the one of the fit report in that file."""
+    data = synthetic_stiffness(PAPER_B, np.linspace(5, 155, 20), [1e-5, 1e-4, 3.5e-4], noise=0.005, seed=3)
+    data.to_csv(tmp_path / "m.csv")
+    write_design(PAPER_B, tmp_path / "d.json")
+    assert main(["fit", str(tmp_path / "m.csv"), "--design", str(tmp_path / "d.json"), "-o",
+                 str(tmp_path / "fitted.json")]) == 0
+    (tmp_path / "t.json").write_text('{"fit_covariance": true, "samples": 100, "seed": 2}')
+    assert main(["stiffness", str(tmp_path / "fitted.json"), "--freq", "10", "10", "1", "--amp", "1e-4",
+                 "--tolerance", str(tmp_path / "t.json"), "-o", str(tmp_path / "k.csv")]) == 0
+    table = pd.read_csv(tmp_path / "k.csv")
+    fitted = json.loads((tmp_path / "fitted.json").read_text())
+    from core import loads_design
+    expected = band(loads_design((tmp_path / "fitted.json").read_text()), 10.0, 1e-4,
+                    Tolerances(covariance=FitCovariance.from_report(fitted["fit"]), samples=100, seed=2))
+    assert table["magnitude_p95"][0] == pytest.approx(float(expected.magnitude[95.0]), rel=1e-9)
+    assert table["magnitude_p5"][0] < table["magnitude"][0] < table["magnitude_p95"][0]
