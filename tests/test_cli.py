@@ -3,8 +3,10 @@
 import csv
 import io
 import json
+import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -141,18 +143,32 @@ def test_help_exits_zero(capsys):
         assert status == 0 and "usage" in out
 
 
+def installed_script() -> list[str]:
+    """The `bushing` console script pip installed beside this Python (pyproject's
+    [project.scripts]), as a user types it."""
+    script = shutil.which("bushing", path=str(Path(sys.executable).parent))
+    assert script is not None, f"no installed `bushing` script in {Path(sys.executable).parent}"
+    return [script]
+
+
 def test_installed_entry_point_runs_without_traceback(designs, tmp_path):
     """The console script as a user types it, in a separate process."""
+    bushing = installed_script()
     ok = subprocess.run(
-        [sys.executable, "-m", "core.cli", "stiffness", str(designs["axial"]), "--freq", "1", "10", "2", "--amp", "1e-4"],
+        [*bushing, "stiffness", str(designs["axial"]), "--freq", "1", "10", "2", "--amp", "1e-4"],
         capture_output=True, text=True, check=False,
     )
     assert ok.returncode == 0 and ok.stdout.splitlines()[0] == ",".join(STIFFNESS_COLUMNS)
+    assert_allclose(read_csv(ok.stdout)[1][:, 4], stiffness(PAPER_B, [1, 10], 1e-4).magnitude.ravel(),
+                    rtol=1e-11)  # 12 printed digits
     bad = subprocess.run(
-        [sys.executable, "-m", "core.cli", "loop", str(tmp_path / "none.json"), "--freq", "1", "--amp", "1e-3"],
+        [*bushing, "loop", str(tmp_path / "none.json"), "--freq", "1", "--amp", "1e-3"],
         capture_output=True, text=True, check=False,
     )
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "Traceback" not in bad.stderr
+    # the script is the whole command line (app.cli), not the core's alone: it knows `serve`
+    helped = subprocess.run([*bushing, "--help"], capture_output=True, text=True, check=False)
+    assert helped.returncode == 0 and "serve" in helped.stdout
 
 
 def test_serve_prints_its_url_and_answers():
