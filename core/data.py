@@ -36,7 +36,9 @@ LOOP_SINE_DEPARTURE = 0.1
 DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
 
 STIFFNESS_KEYS = ("frequency_hz", "amplitude")
-STIFFNESS_PAIRS = (("magnitude", "loss_factor"), ("stiffness_real", "stiffness_imag"))
+# the three forms of complex stiffness a file may give; only the last two carry the sign of Re K
+STIFFNESS_PAIRS = (("magnitude", "loss_factor"), ("stiffness_real", "stiffness_imag"), ("magnitude", "phase_deg"))
+PHASE_DEG = (-180.0, 180.0)  # the phase of K = |K| e^{iφ} in degrees, as test rigs write it
 LOOP_COLUMNS = ("time_s", "displacement", "force")
 
 
@@ -50,9 +52,11 @@ def magnitude_residual_pct(k_model, k_data) -> np.ndarray:
 
 
 def loss_factor(k) -> np.ndarray:
-    """η = Im K / Re K of complex stiffness (docs/model.md)."""
+    """η = Im K / Re K of complex stiffness (docs/model.md), with its sign: negative where
+    Im K < 0 or Re K < 0; ±inf where Re K = 0 exactly (no warning)."""
     k = np.asarray(k)
-    return k.imag / k.real
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return k.imag / k.real
 
 
 class ComplexStiffness:
@@ -347,18 +351,20 @@ def read_loop(path) -> MeasuredLoop:
 
 
 def parse_stiffness(text: str | bytes) -> MeasuredStiffness:
-    """Parse a measured-stiffness CSV: columns frequency_hz, amplitude and either magnitude,
-    loss_factor or stiffness_real, stiffness_imag; one row per point."""
+    """Parse a measured-stiffness CSV: columns frequency_hz, amplitude and one form of the complex
+    stiffness (:data:`STIFFNESS_PAIRS`: magnitude + loss_factor, stiffness_real + stiffness_imag
+    or magnitude + phase_deg); one row per point. Any finite, non-zero complex K is accepted."""
     df = _table(text, "stiffness")
     cols = set(df.columns)
-    pair = next((p for p in STIFFNESS_PAIRS if set(p) <= cols), None)
+    pairs = [p for p in STIFFNESS_PAIRS if set(p) <= cols]
     missing = [c for c in STIFFNESS_KEYS if c not in cols]
-    if missing or pair is None:
-        need = " and ".join(" + ".join(p) for p in STIFFNESS_PAIRS)
-        raise DataError(
-            f"line 1: the header must name frequency_hz, amplitude and either {need.replace(' and ', ' or ')}"
-            f" (found: {', '.join(df.columns)})"
-        )
+    if missing or not pairs:
+        need = " or ".join(" + ".join(p) for p in STIFFNESS_PAIRS)
+        raise DataError(f"line 1: the header must name frequency_hz, amplitude and either {need}"
+                        f" (found: {', '.join(df.columns)})")
+    if len(pairs) > 1:  # loss_factor beside phase_deg, or both polar and Cartesian: which one holds?
+        raise DataError(f"line 1: give one form of the stiffness, not {' and '.join(' + '.join(p) for p in pairs)}")
+    pair = pairs[0]
     extra = cols - set(STIFFNESS_KEYS) - set(pair) - {"mode"}
     if extra:
         raise DataError(f"line 1: unknown column(s) {', '.join(sorted(extra))}")
@@ -377,20 +383,31 @@ def parse_stiffness(text: str | bytes) -> MeasuredStiffness:
     if outside.size:
         raise DataError(f"line {outside[0] + 2}: frequency_hz must be within {lo:g}–{hi:g} Hz, got "
                         f"{v['frequency_hz'][outside[0]]:g}")
-    if pair[0] == "magnitude":
-        _positive(v, "magnitude")
-        eta = v["loss_factor"]
-        k = v["magnitude"] * (1 + 1j * eta) / np.sqrt(1 + eta**2)
-    else:
-        k = v["stiffness_real"] + 1j * v["stiffness_imag"]
-        bad = np.flatnonzero(np.abs(k) == 0)
-        if bad.size:
-            raise DataError(f"line {bad[0] + 2}: the stiffness is zero")
-    active = np.flatnonzero(k.imag < 0)
-    if active.size:  # a passive specimen dissipates: Im K ≥ 0
-        raise DataError(f"line {active[0] + 2}: a negative loss factor (Im K < 0) would mean the bushing gives "
-                        "energy back each cycle; a rubber bushing cannot")
+    k = _complex_stiffness(v, pair)
+    # any finite complex stiffness is a possible measurement: Im K < 0 (a negative loss factor)
+    # is a blocked transfer stiffness above a wave resonance, Re K < 0 a mass-dominated one
+    with np.errstate(over="ignore"):
+        bad = np.flatnonzero(~np.isfinite(np.abs(k)) | (np.abs(k) == 0))
+    if bad.size:
+        raise DataError(f"line {bad[0] + 2}: the stiffness is zero or too large for a number")
     return MeasuredStiffness(v["frequency_hz"], v["amplitude"], k, None, mode)
+
+
+def _complex_stiffness(v: dict[str, np.ndarray], pair: tuple[str, str]) -> np.ndarray:
+    """Complex K from one of :data:`STIFFNESS_PAIRS` (columns already finite numbers)."""
+    if pair[0] == "stiffness_real":
+        return v["stiffness_real"] + 1j * v["stiffness_imag"]
+    _positive(v, "magnitude")
+    if pair[1] == "loss_factor":
+        # η = Im K / Re K with Re K > 0: this form cannot say Re K < 0 (docs/files.md)
+        eta = v["loss_factor"]
+        return v["magnitude"] * ((1 + 1j * eta) / np.hypot(1.0, eta))
+    phase = v["phase_deg"]
+    lo, hi = PHASE_DEG
+    bad = np.flatnonzero((phase < lo) | (phase > hi))
+    if bad.size:
+        raise DataError(f"line {bad[0] + 2}: phase_deg must be within {lo:g}…{hi:g} degrees, got {phase[bad[0]]:g}")
+    return v["magnitude"] * np.exp(1j * np.deg2rad(phase))
 
 
 def combined(parts: list[MeasuredStiffness], default_mode: str) -> MeasuredStiffness:
