@@ -54,8 +54,10 @@ sensitivities of |K| and the loss factor follow the operating point; targets on 
 factor and the radial/axial ratio find the nearest design that meets them, or say why none can.
 
 **Files.** *Measured stiffness* (CSV): a header row `frequency_hz,amplitude,magnitude,loss_factor`
-(or `stiffness_real,stiffness_imag` instead of the last two), then one row per point; amplitude
-the peak displacement in m (axial, radial) or angle in rad (torsion, conical), |K| in N/m or N·m/rad. *Measured
+(or `stiffness_real,stiffness_imag`, or `magnitude,phase_deg` with the phase in degrees, instead of
+the last two; only these two carry Re K < 0), then one row per point; amplitude the peak
+displacement in m (axial, radial) or angle in rad (torsion, conical), |K| in N/m or N·m/rad. A
+negative loss factor (a blocked stiffness above a wave resonance) is a measurement like any other. *Measured
 loop* (CSV): `time_s,displacement,force`, one or more periods of a steady harmonic test. *Design
 file* (JSON): `mode` (`axial`, `torsion`, `radial`, `conical`), optional `shape` (`long`,
 `finite`), `geometry` (`inner_radius`, `outer_radius`, `length` in m), `material`
