@@ -259,7 +259,9 @@ def test_contradicting_targets_are_said_to_contradict_each_other(tmp_path):
     closest = report["closest"]
     assert closest["binding_limits"] == []
     reached = magnitude_at(tmp_path, closest["design"])
-    assert 4e6 < reached < 5e6  # the least miss of |K| ≥ 5 and ≤ 4 kN/mm lies between them
+    # the least miss of |K| ≥ 5 and ≤ 4 kN/mm lies between them, near the middle: 4.39 MN/m for
+    # the least squared relative misses, 4.47 for the least squared log misses (not the start's 4.06)
+    assert 4.3e6 < reached < 4.6e6
     low, high = closest["targets"]
     assert low["value"] == pytest.approx(reached, rel=1e-9) and high["value"] == pytest.approx(reached, rel=1e-9)
     assert low["miss"] == pytest.approx(reached / 5e6 - 1, rel=1e-9)
