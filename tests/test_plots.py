@@ -66,9 +66,11 @@ def test_slices_branches_residuals_and_diagnosis_plots():
         assert hv.render(layout) is not None
 
 
-@pytest.mark.parametrize("width", [None, 450])
-def test_widths(width):
-    layout = plots.slices_plots(PAPER_B, width=width)
-    widths = {p.width for p in hv.render(layout).select({"type": Plot})}
-    assert widths == ({450} if width else widths)
+@pytest.mark.parametrize("width, expected", [(None, (None, "stretch_width")), (450, (450, "fixed")),
+                                             ("default", (800, "fixed"))])
+def test_widths(width, expected):
+    """A width in pixels is that width, fixed; None is no width, stretched to the container's."""
+    layout = plots.slices_plots(PAPER_B) if width == "default" else plots.slices_plots(PAPER_B, width=width)
+    rendered = list(hv.render(layout).select({"type": Plot}))
+    assert len(rendered) == 3 and {(p.width, p.sizing_mode) for p in rendered} == {expected}
     assert all(ov.opts.get().kwargs.get("responsive") is (width is None) for ov in layout)
