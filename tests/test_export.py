@@ -191,3 +191,86 @@ def test_the_explorers_export_panel_writes_every_tool_format():
     assert json.loads(texts["Neutral table, every direction (JSON)"])["header"]["design"] == app.state.design.to_dict()
     app.export.tool_format.value = "Adams bushing file (.bus)"
     assert app.export.tool_file.filename == "bushing.bus"
+
+
+# ---- the command line's Adams file, read back by a parser of docs/export.md ---------------------
+
+ADAMS_DIRECTIONS = (  # docs/export.md: curve, damping, mode, (column names); z is the bushing axis
+    ("Z_FORCE_CURVE", "Z_DAMPING", "axial", ("disp", "force")),
+    ("X_FORCE_CURVE", "X_DAMPING", "radial", ("disp", "force")),
+    ("Y_FORCE_CURVE", "Y_DAMPING", "radial", ("disp", "force")),
+    ("Z_TORQUE_CURVE", "RZ_DAMPING", "torsion", ("rot", "torque")),
+    ("X_TORQUE_CURVE", "RX_DAMPING", "conical", ("rot", "torque")),
+    ("Y_TORQUE_CURVE", "RY_DAMPING", "conical", ("rot", "torque")),
+)
+
+
+def teim_orbit(text):
+    """A TeimOrbit file read strictly: `$` comments, `[SECTION]`, `KEY = value` (quotes off),
+    `(SUBSECTION)`, `{col col}` naming the columns of the rows of numbers that follow, and
+    a quoted comment string. Anything else is an error."""
+    sections, current = {}, None
+    for number, line in enumerate(text.splitlines(), 1):
+        line = line.strip()
+        if not line or line.startswith("$"):
+            continue
+        if re.fullmatch(r"\[[A-Z_]+\]", line):
+            assert line[1:-1] not in sections, f"line {number}: {line} twice"
+            current = sections[line[1:-1]] = {"keys": {}, "columns": None, "rows": [], "text": []}
+        elif (m := re.fullmatch(r"([A-Z_]+)\s*=\s*(.+)", line)) and current is not None:
+            current["keys"][m.group(1)] = m.group(2).strip().strip("'")
+        elif (m := re.fullmatch(r"\{\s*(.+?)\s*\}", line)) and current is not None:
+            current["columns"] = tuple(m.group(1).split())
+        elif re.fullmatch(r"\(\w+\)", line) or re.fullmatch(r"'.*'", line):
+            current["text"].append(line.strip("'"))
+        else:
+            values = [float(v) for v in line.split()]  # a row of numbers, or a ValueError
+            assert current is not None and current["columns"] and len(values) == len(current["columns"]), number
+            current["rows"].append(values)
+    return sections
+
+
+def card_rows(design_path, freq, amp_mm, amp_rad, capsys):
+    """`bushing card` as parsed CSV: mode → row."""
+    assert main(["card", str(design_path), "--freq", str(freq), "--amp-mm", repr(float(amp_mm)),
+                 "--amp-rad", repr(float(amp_rad))]) == 0
+    table = pd.read_csv(io.StringIO(capsys.readouterr().out))
+    return {row["mode"]: row for _, row in table.iterrows()}
+
+
+def test_the_command_lines_adams_file_carries_the_cards_stiffness(tmp_path, capsys):
+    """`bushing export --format adams` over a grid: linearised at its first frequency (10 Hz) and
+    first amplitude (0.1 mm axially; every direction at the same equivalent strain). Each curve's
+    slope is K' and each DAMPING is C = K''/ω of `bushing card` at that direction's amplitude."""
+    design = tmp_path / "paper_b.json"
+    write_design(PAPER_B, design)
+    out = tmp_path / "bushing.bus"
+    assert main(["export", str(design), "--format", "adams", "--freq", "10", "30", "3",
+                 "--amp", "1e-4", "2e-4", "-o", str(out)]) == 0
+    assert capsys.readouterr().out == ""
+    sections = teim_orbit(out.read_text(encoding="utf-8"))
+    assert set(sections) == {"MDI_HEADER", "UNITS"} | {s for d in ADAMS_DIRECTIONS for s in d[:2]}
+    header = sections["MDI_HEADER"]
+    assert header["keys"] == {"FILE_TYPE": "bus", "FILE_VERSION": "4.0", "FILE_FORMAT": "ASCII"}
+    assert re.search(r"linearised at 10 Hz", " ".join(header["text"]))
+    omega = 2 * math.pi * 10.0
+    loss_factors = []
+    for curve, damping, mode, columns in ADAMS_DIRECTIONS:
+        section = sections[curve]
+        assert section["columns"] == columns, curve
+        x, force = np.array(section["rows"]).T
+        peak = x.max()
+        # five points through ±x̂ (10 printed digits)
+        np.testing.assert_allclose(x, peak * np.array([-1, -0.5, 0, 0.5, 1]), rtol=1e-9, atol=1e-12 * peak)
+        if mode == "axial":
+            assert peak == pytest.approx(1e-4, rel=1e-12)  # the design's own mode: the first --amp
+        rows = card_rows(design, 10, peak * 1e3 if mode in ("axial", "radial") else 0.1,
+                         peak if mode in ("torsion", "conical") else 0.01, capsys)
+        k = rows[mode]["stiffness_real"] + 1j * rows[mode]["stiffness_imag"]
+        # the card's 12 digits against the file's 10: 2e-9 relative, and x̂ read to 10 digits
+        np.testing.assert_allclose(force, k.real * x, rtol=1e-8, atol=1e-9 * abs(k.real) * peak, err_msg=curve)
+        c = float(sections[damping]["keys"]["DAMPING"])
+        assert c == pytest.approx(k.imag / omega, rel=1e-8), damping
+        loss_factors.append(c * omega / (force[-1] / peak))
+    # K = S µ_eq(ω, ε) (eqs 16-18): at one equivalent strain every direction has the same loss factor
+    np.testing.assert_allclose(loss_factors, loss_factors[0], rtol=1e-8)
