@@ -13,8 +13,8 @@ from app.cli import main
 from core import PAPER_B, TABLE_1, write_design
 from core.bushing import stiffness_points
 from core.data import loss_factor
-from core.fit import fit_global
-from core.sensitivity import elasticities, log_derivatives, sentence
+from core.fit import PARAMETERS, fit_global, parameter
+from core.sensitivity import elasticities, log_derivatives, sentence, value_of
 from core.synthetic import synthetic_stiffness
 from core.target import TargetError, problem_from_dict, solve
 from core.tolerance import FitCovariance, ToleranceError, Tolerances, band, loads_tolerances
@@ -68,9 +68,41 @@ def test_a_fits_covariance_makes_a_band_that_agrees_with_first_order():
     np.testing.assert_allclose(b.std_magnitude, b.first_order_magnitude, rtol=0.05)
     assert np.all(b.std_magnitude / b.nominal_magnitude < 0.02)  # a good fit: a narrow band
     assert np.all(b.magnitude[5.0] < b.nominal_magnitude) and np.all(b.nominal_magnitude < b.magnitude[95.0])
-    # the same from the fitted design file's report
-    same = FitCovariance.from_report(json.loads(fit.to_json())["fit"])
-    assert same.matrix(fit.design)[0] == tol.covariance.matrix(fit.design)[0]
+    # the covariance the band draws from, read back from the fitted design file's report, is
+    # s² (JᵀJ)⁻¹ of the fit's misfit in its coordinates, J by central differences here
+    names, cov = FitCovariance.from_report(json.loads(fit.to_json())["fit"]).matrix(fit.design)
+    assert names == tuple(PARAMETERS)
+    expected = jacobian_covariance(fit.design, data, names)
+    scale = np.sqrt(np.outer(np.diag(expected), np.diag(expected)))
+    # the fit's forward-difference Jacobian and its stopping point hold the matrix to ~4e-7 of
+    # each element's scale √(Σᵢᵢ Σⱼⱼ) here; 1e-4 leaves room and catches any wrong term or unit
+    np.testing.assert_allclose(cov / scale, expected / scale, rtol=0, atol=1e-4)
+    # and the draws follow it: their sample covariance within 4.5 standard errors,
+    # √((Σᵢᵢ Σⱼⱼ + Σᵢⱼ²)/N), of every element
+    draws = tol.draws(fit.design)
+    theta = np.array([[np.log(d[n]) if parameter(n).log else d[n] for n in names] for d in draws])
+    sample = np.cov(theta, rowvar=False)
+    se = np.sqrt((np.outer(np.diag(expected), np.diag(expected)) + expected**2) / len(draws))
+    assert np.all(np.abs(sample - expected) < 4.5 * se), (sample - expected) / se
+
+
+def jacobian_covariance(design, data, names, step=1e-5):
+    """s² (JᵀJ)⁻¹ of the relative complex misfit (K − K_data)/|K_data| in the fit's coordinates
+    (ln p, α itself) at ``design``, J by central differences, s² the residual variance: the
+    covariance a least-squares fit implies, by a route apart from core.fit's."""
+    log = [parameter(n).log for n in names]
+    theta0 = np.array([np.log(value_of(design, n)) if lg else value_of(design, n) for n, lg in zip(names, log)])
+
+    def residual(theta):
+        values = {n: float(np.exp(t)) if lg else float(t) for n, lg, t in zip(names, log, theta)}
+        k = stiffness_points(design.replace(**values), data.frequency_hz, data.amplitude)
+        r = (k - data.stiffness) / np.abs(data.stiffness)
+        return np.concatenate([r.real, r.imag])
+
+    jac = np.column_stack([(residual(theta0 + step * e) - residual(theta0 - step * e)) / (2 * step)
+                           for e in np.eye(len(names))])
+    r0 = residual(theta0)
+    return r0 @ r0 / (r0.size - len(names)) * np.linalg.inv(jac.T @ jac)
 
 
 @pytest.mark.parametrize("text, match", [
