@@ -1,18 +1,26 @@
 """Small helpers shared by tests that start a server."""
 
+import asyncio
+import contextlib
+import queue
 import socket
+import threading
 import time
 import urllib.request
 
 
 def free_port() -> int:
+    """A port that was free a moment ago. Racy (another process may take it before the caller
+    binds it): for tests/test_cli.py's `bushing serve --port`; new tests bind port 0 instead
+    (:func:`served`)."""
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
 
 
 def wait_for(url: str, timeout: float = 30.0) -> bytes:
-    """The body of ``url`` once it answers 200; fails after ``timeout`` seconds."""
+    """The body of ``url`` once it answers 200, for a server that may not listen yet (another
+    process starting); fails after ``timeout`` seconds."""
     deadline = time.time() + timeout
     while True:
         try:
@@ -23,6 +31,57 @@ def wait_for(url: str, timeout: float = 30.0) -> bytes:
             if time.time() > deadline:
                 raise
         time.sleep(0.2)
+
+
+def fetch(url: str, timeout: float = 60.0) -> bytes:
+    """The body of ``url`` (one request, no retry): for a server whose socket already listens,
+    the request waits in the listen backlog until the server answers."""
+    with urllib.request.urlopen(url, timeout=timeout) as r:
+        assert r.status == 200, (url, r.status)
+        return r.read()
+
+
+@contextlib.contextmanager
+def served(app_factory, **kwargs):
+    """``app_factory`` served by Panel on 127.0.0.1 at a port the OS picks, in a thread with its
+    own event loop: yields the Bokeh server (``server.port``), stopped and its thread joined on
+    exit. The socket is bound before this yields, so there is nothing to wait for (and no "find
+    a free port, then bind it" race). Without ``websocket_origin``, Bokeh accepts pages from
+    ``localhost:<port>``: open ``http://localhost:<port>/``."""
+    import panel as pn
+    from tornado.ioloop import IOLoop
+
+    made = queue.Queue()
+
+    def run():
+        asyncio.set_event_loop(asyncio.new_event_loop())
+        try:
+            server = pn.serve(app_factory, port=0, address="127.0.0.1", show=False, start=False,
+                              loop=IOLoop.current(), **kwargs)
+        except BaseException as exc:  # noqa: BLE001 - handed to the test's thread
+            made.put(exc)
+            return
+        made.put(server)
+        server.start()
+        server.io_loop.start()  # until stop() below
+        server.io_loop.close(all_fds=True)
+
+    thread = threading.Thread(target=run, name="served", daemon=True)
+    thread.start()
+    server = made.get(timeout=120)
+    if isinstance(server, BaseException):
+        raise server
+
+    def stop():
+        server.stop()
+        server.io_loop.stop()
+
+    try:
+        yield server
+    finally:
+        server.io_loop.add_callback(stop)
+        thread.join(60)
+        assert not thread.is_alive(), "the server's thread did not stop"
 
 
 # ---- what a HoloViews plot holds ------------------------------------------------------------
