@@ -33,8 +33,9 @@ def main(out: Path = HERE) -> None:
     synthetic_stiffness(PAPER_B, np.linspace(1, 100, 100), [0.1e-3], seed=12347).to_csv(
         out / "paper_b_sweep_0.1mm.csv")
     # Table 1 bushing (torsion): 10-100 Hz at five angles, as real and imaginary parts
-    synthetic_stiffness(TABLE_1, np.linspace(10, 100, 19), [1.74e-5, 1.74e-4, 1.74e-3, 1.74e-2, 1.74e-1],
-                        seed=12348).to_csv(out / "table1_torsion_stiffness.csv", polar=False)
+    synthetic_stiffness(TABLE_1, np.linspace(10, 100, 19),
+                        [1.74e-5, 1.74e-4, 1.74e-3, 1.74e-2, 1.74e-1], seed=12348).to_csv(
+        out / "table1_torsion_stiffness.csv", polar=False)
     # starting guesses: the right geometry, a deliberately poor material
     write_design(PAPER_B.replace(name="Paper B geometry, starting guess", shear_modulus=1.5e6,
                                  fractional_coefficient=1.0e6, fractional_order=0.4,
@@ -45,8 +46,9 @@ def main(out: Path = HERE) -> None:
                                  friction_stress_max=1.0e4, friction_strain_half=3.0e-3),
                  out / "table1_guess.json")
     # the discrepancy workflow: Paper B measured through a 0.5 kg fixture (inertia the model lacks)
-    synthetic_stiffness(PAPER_B.replace(effects={"inertia": {"mass": 0.5}}), np.linspace(1, 100, 30),
-                        PAPER_B_AMPLITUDES, seed=12349).to_csv(out / "paper_b_with_fixture_mass.csv")
+    synthetic_stiffness(PAPER_B.replace(effects={"inertia": {"mass": 0.5}}),
+                        np.linspace(1, 100, 30), PAPER_B_AMPLITUDES, seed=12349).to_csv(
+        out / "paper_b_with_fixture_mass.csv")
     write_design(PAPER_B, out / "paper_b_true.json")
     write_design(TABLE_1, out / "table1_true.json")
 

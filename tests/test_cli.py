@@ -16,7 +16,8 @@ from app.cli import main  # the `bushing` entry point
 from core import PAPER_B, TABLE_1, loop, stiffness, write_design
 from tests.helpers import free_port, wait_for
 
-STIFFNESS_COLUMNS = ["frequency_hz", "amplitude", "stiffness_real", "stiffness_imag", "magnitude", "loss_factor"]
+STIFFNESS_COLUMNS = ["frequency_hz", "amplitude", "stiffness_real", "stiffness_imag", "magnitude",
+                     "loss_factor"]
 LOOP_COLUMNS = ["displacement", "force", "force_elastic", "force_viscoelastic", "force_friction"]
 
 
@@ -44,7 +45,8 @@ def read_csv(text):
 
 
 def test_stiffness_to_stdout(designs, capsys):
-    status, out, err = run(["stiffness", designs["axial"], "--freq", 1, 100, 5, "--amp", 1e-4, 1e-3], capsys)
+    argv = ["stiffness", designs["axial"], "--freq", 1, 100, 5, "--amp", 1e-4, 1e-3]
+    status, out, err = run(argv, capsys)
     assert status == 0 and err == ""
     header, data = read_csv(out)
     assert header == STIFFNESS_COLUMNS and data.shape == (10, 6)
@@ -59,7 +61,8 @@ def test_stiffness_to_stdout(designs, capsys):
 def test_stiffness_log_grid_slices_and_file(designs, capsys, tmp_path):
     out_path = tmp_path / "k.csv"
     status, out, _ = run(
-        ["stiffness", designs["torsion"], "--freq", 10, 1000, 3, "--log", "--amp", 1e-3, "--slices", 3, "-o", out_path],
+        ["stiffness", designs["torsion"], "--freq", 10, 1000, 3, "--log", "--amp", 1e-3,
+         "--slices", 3, "-o", out_path],
         capsys,
     )
     assert status == 0 and out == ""
@@ -70,16 +73,20 @@ def test_stiffness_log_grid_slices_and_file(designs, capsys, tmp_path):
 
 
 def test_stiffness_continuum_and_time_domain(designs, capsys):
-    _, out, _ = run(["stiffness", designs["axial"], "--freq", 10, 10, 1, "--amp", 2e-4, "--continuum"], capsys)
+    argv = ["stiffness", designs["axial"], "--freq", 10, 10, 1, "--amp", 2e-4, "--continuum"]
+    _, out, _ = run(argv, capsys)
     cont = read_csv(out)[1]
-    assert_allclose(cont[0, 4], stiffness(PAPER_B, 10, 2e-4, slices="continuum").magnitude[0, 0], rtol=1e-11)
-    _, out, _ = run(["stiffness", designs["axial"], "--freq", 10, 10, 1, "--amp", 2e-4, "--route", "time-domain"], capsys)
+    assert_allclose(cont[0, 4], stiffness(PAPER_B, 10, 2e-4, slices="continuum").magnitude[0, 0],
+                    rtol=1e-11)
+    _, out, _ = run(["stiffness", designs["axial"], "--freq", 10, 10, 1, "--amp", 2e-4,
+                     "--route", "time-domain"], capsys)
     td = read_csv(out)[1]
     assert_allclose(td[0, 4], stiffness(PAPER_B, 10, 2e-4).magnitude[0, 0], rtol=1e-4)
 
 
 def test_loop(designs, capsys):
-    status, out, _ = run(["loop", designs["axial"], "--freq", 0.1, "--amp", 1e-3, "--points", 64], capsys)
+    status, out, _ = run(["loop", designs["axial"], "--freq", 0.1, "--amp", 1e-3, "--points", 64],
+                         capsys)
     assert status == 0
     header, data = read_csv(out)
     assert header == LOOP_COLUMNS and data.shape == (64, 5)
@@ -110,9 +117,11 @@ BAD = [
     (["stiffness", "{axial}", "--freq", 1, 100, 5, "--amp", "abc"], "--amp"),
     (["stiffness", "{axial}", "--freq", 1, 100, 5], "--amp"),
     (["stiffness", "{axial}", "--freq", 1, 100, 5, "--amp", 1e-4, "--slices", 0], "--slices"),
-    (["stiffness", "{axial}", "--freq", 1, 100, 5, "--amp", 1e-4, "--slices", 2, "--continuum"], "--continuum"),
+    (["stiffness", "{axial}", "--freq", 1, 100, 5, "--amp", 1e-4, "--slices", 2, "--continuum"],
+     "--continuum"),
     (["stiffness", "{axial}", "--freq", 1, 100, 5, "--amp", 1e-4, "--route", "magic"], "--route"),
-    (["stiffness", "{axial}", "--freq", 1, 100, 5, "--amp", 1e-4, "-o", "/no/such/dir/k.csv"], "cannot write"),
+    (["stiffness", "{axial}", "--freq", 1, 100, 5, "--amp", 1e-4, "-o", "/no/such/dir/k.csv"],
+     "cannot write"),
     (["stiffness", "missing.json", "--freq", 1, 100, 5, "--amp", 1e-4], "cannot read"),
     (["stiffness", "{bad}", "--freq", 1, 100, 5, "--amp", 1e-4], "geometry.outer_radius"),
     (["loop", "{axial}", "--freq", "nan", "--amp", 1e-3], "--freq"),
@@ -159,8 +168,8 @@ def test_installed_entry_point_runs_without_traceback(designs, tmp_path):
         capture_output=True, text=True, check=False,
     )
     assert ok.returncode == 0 and ok.stdout.splitlines()[0] == ",".join(STIFFNESS_COLUMNS)
-    assert_allclose(read_csv(ok.stdout)[1][:, 4], stiffness(PAPER_B, [1, 10], 1e-4).magnitude.ravel(),
-                    rtol=1e-11)  # 12 printed digits
+    assert_allclose(read_csv(ok.stdout)[1][:, 4],
+                    stiffness(PAPER_B, [1, 10], 1e-4).magnitude.ravel(), rtol=1e-11)  # 12 digits
     bad = subprocess.run(
         [*bushing, "loop", str(tmp_path / "none.json"), "--freq", "1", "--amp", "1e-3"],
         capture_output=True, text=True, check=False,

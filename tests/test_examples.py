@@ -67,7 +67,7 @@ def assert_same_json(made, committed, where=""):
         for i, (a, b) in enumerate(zip(made, committed)):
             assert_same_json(a, b, f"{where}[{i}]")
     elif isinstance(committed, (int, float)) and not isinstance(committed, bool):
-        # design files: the stated constants, written by json as the shortest repr, read back exactly
+        # design files: the stated constants, written by json as their shortest repr: exact
         assert made == pytest.approx(committed, rel=1e-15), where
     else:
         assert made == committed, where
@@ -78,7 +78,8 @@ def test_the_generator_writes_every_committed_data_file(generated):
     committed = {p.name for p in EXAMPLES.iterdir() if p.suffix in (".csv", ".json")}
     assert made, "make_examples.py wrote nothing"
     assert made <= committed, f"generated but not committed: {sorted(made - committed)}"
-    assert committed - made == BY_HAND, f"committed, not generated: {sorted(committed - made - BY_HAND)}"
+    extra = sorted(committed - made - BY_HAND)
+    assert committed - made == BY_HAND, f"committed, not generated: {extra}"
 
 
 @pytest.mark.parametrize("name", sorted(

@@ -23,7 +23,8 @@ DOCS = Path(__file__).resolve().parents[1] / "docs" / "export.md"
 
 
 def expected(mode, amp_design_mode, f, design=PAPER_B):
-    """The core's K of ``mode`` at the equivalent strain of ``amp_design_mode`` in the design's mode."""
+    """The core's K of ``mode`` at the equivalent strain of ``amp_design_mode`` in the design's
+    mode."""
     own = card_design(design, design.mode)
     eps = strain_factor(own.geometry, own.mode, own.shape) * amp_design_mode
     d = card_design(design, mode)
@@ -34,9 +35,11 @@ def expected(mode, amp_design_mode, f, design=PAPER_B):
 def test_neutral_csv_table():
     table = pd.read_csv(io.StringIO(export(PAPER_B, "table", FREQS, AMPS)))
     assert len(table) == 4 * len(AMPS) * len(FREQS)
-    assert set(table.loc[table["mode"] == "axial", "amplitude"]) == set(AMPS)  # the design's own mode: as given
+    # the design's own mode: as given
+    assert set(table.loc[table["mode"] == "axial", "amplitude"]) == set(AMPS)
     for _, row in table.sample(12, random_state=0).iterrows():
-        i = int(np.argmin(np.abs(np.log(table.loc[(table["mode"] == row["mode"]), "amplitude"].unique() / row["amplitude"]))))
+        amps = table.loc[(table["mode"] == row["mode"]), "amplitude"].unique()
+        i = int(np.argmin(np.abs(np.log(amps / row["amplitude"]))))
         amp, k = expected(row["mode"], AMPS[i], row["frequency_hz"])
         assert row["amplitude"] == pytest.approx(amp, rel=1e-10)
         assert row["stiffness_real"] == pytest.approx(k.real, rel=1e-10)
@@ -128,9 +131,10 @@ def adams_sections(text):
 def test_adams_bus_file():
     sections = adams_sections(export(PAPER_B, "adams", [10.0], [1e-4]))
     assert sections["MDI_HEADER"]["keys"]["FILE_TYPE"] == "bus"
-    assert sections["UNITS"]["keys"] == {"LENGTH": "meter", "ANGLE": "radians", "FORCE": "newton", "MASS": "kg",
-                                         "TIME": "second"}
-    for mode, curve, damping in (("axial", "Z_FORCE_CURVE", "Z_DAMPING"), ("radial", "Y_FORCE_CURVE", "Y_DAMPING"),
+    assert sections["UNITS"]["keys"] == {"LENGTH": "meter", "ANGLE": "radians", "FORCE": "newton",
+                                         "MASS": "kg", "TIME": "second"}
+    for mode, curve, damping in (("axial", "Z_FORCE_CURVE", "Z_DAMPING"),
+                                 ("radial", "Y_FORCE_CURVE", "Y_DAMPING"),
                                  ("torsion", "Z_TORQUE_CURVE", "RZ_DAMPING"),
                                  ("conical", "X_TORQUE_CURVE", "RX_DAMPING")):
         amp, k = expected(mode, 1e-4, 10.0)
@@ -138,7 +142,8 @@ def test_adams_bus_file():
         assert rows[:, 0].min() == pytest.approx(-amp) and rows[:, 0].max() == pytest.approx(amp)
         slope = np.polyfit(rows[:, 0], rows[:, 1], 1)[0]
         assert slope == pytest.approx(k.real, rel=1e-8)
-        assert float(sections[damping]["keys"]["DAMPING"]) == pytest.approx(k.imag / (2 * math.pi * 10.0), rel=1e-8)
+        c = float(sections[damping]["keys"]["DAMPING"])
+        assert c == pytest.approx(k.imag / (2 * math.pi * 10.0), rel=1e-8)
 
 
 def test_the_co_simulation_loop_of_the_docs_gives_the_force_history():
@@ -152,14 +157,17 @@ def test_the_co_simulation_loop_of_the_docs_gives_the_force_history():
 
 def test_the_command_line_export_and_its_limits(tmp_path, capsys):
     write_design(PAPER_B, tmp_path / "d.json")
-    assert main(["export", str(tmp_path / "d.json"), "--format", "table", "--freq", "1", "100", "3", "--amp",
-                 "1e-4", "-o", str(tmp_path / "t.json")]) == 0
-    assert json.loads((tmp_path / "t.json").read_text())["directions"]["radial"]["amplitude_unit"] == "m"
-    assert main(["export", str(tmp_path / "d.json"), "--format", "nastran", "--freq", "1", "100", "3", "--amp",
-                 "1e-4"]) == 0
+    assert main(["export", str(tmp_path / "d.json"), "--format", "table", "--freq", "1", "100", "3",
+                 "--amp", "1e-4", "-o", str(tmp_path / "t.json")]) == 0
+    radial = json.loads((tmp_path / "t.json").read_text())["directions"]["radial"]
+    assert radial["amplitude_unit"] == "m"
+    assert main(["export", str(tmp_path / "d.json"), "--format", "nastran", "--freq", "1", "100",
+                 "3", "--amp", "1e-4"]) == 0
     assert capsys.readouterr().out.count("PBUSH ") == 1
-    for argv, needle in ((["--format", "abaqus", "--freq", "1", "10", "2", "--amp", "1e-4"], "--format"),
-                         (["--format", "table", "--freq", "1", "10", "100000", "--amp", "1e-4", "2e-4"], "at most")):
+    refused_argv = ((["--format", "abaqus", "--freq", "1", "10", "2", "--amp", "1e-4"], "--format"),
+                    (["--format", "table", "--freq", "1", "10", "100000", "--amp", "1e-4", "2e-4"],
+                     "at most"))
+    for argv, needle in refused_argv:
         with pytest.raises(SystemExit) as refused:
             main(["export", str(tmp_path / "d.json"), *argv])
         assert refused.value.code == 2 and needle in capsys.readouterr().err
@@ -168,7 +176,8 @@ def test_the_command_line_export_and_its_limits(tmp_path, capsys):
 def test_grid_amplitudes_follow_the_equivalent_strain():
     grid = direction_grid(PAPER_B.replace(mode="torsion"), FREQS, [0.01])
     assert grid["torsion"]["amplitude"][0] == pytest.approx(0.01)
-    c = {m: strain_factor(card_design(PAPER_B, m).geometry, m, card_design(PAPER_B, m).shape) for m in CARD_MODES}
+    designs = {m: card_design(PAPER_B, m) for m in CARD_MODES}
+    c = {m: strain_factor(d.geometry, m, d.shape) for m, d in designs.items()}
     for m in CARD_MODES:
         assert c[m] * grid[m]["amplitude"][0] == pytest.approx(grid["strain"][0], rel=1e-12)
 
@@ -188,7 +197,8 @@ def test_the_explorers_export_panel_writes_every_tool_format():
     assert slope == pytest.approx(k.real, rel=1e-8)
     table = pd.read_csv(io.StringIO(texts["Neutral table, every direction (CSV)"]))
     assert table["frequency_hz"].nunique() == 30 and set(table["mode"]) == set(CARD_MODES)
-    assert json.loads(texts["Neutral table, every direction (JSON)"])["header"]["design"] == app.state.design.to_dict()
+    header = json.loads(texts["Neutral table, every direction (JSON)"])["header"]
+    assert header["design"] == app.state.design.to_dict()
     app.export.tool_format.value = "Adams bushing file (.bus)"
     assert app.export.tool_file.filename == "bushing.bus"
 
@@ -225,7 +235,8 @@ def teim_orbit(text):
             current["text"].append(line.strip("'"))
         else:
             values = [float(v) for v in line.split()]  # a row of numbers, or a ValueError
-            assert current is not None and current["columns"] and len(values) == len(current["columns"]), number
+            assert current is not None and current["columns"], number
+            assert len(values) == len(current["columns"]), number
             current["rows"].append(values)
     return sections
 
@@ -261,16 +272,18 @@ def test_the_command_lines_adams_file_carries_the_cards_stiffness(tmp_path, caps
         x, force = np.array(section["rows"]).T
         peak = x.max()
         # five points through ±x̂ (10 printed digits)
-        np.testing.assert_allclose(x, peak * np.array([-1, -0.5, 0, 0.5, 1]), rtol=1e-9, atol=1e-12 * peak)
+        np.testing.assert_allclose(x, peak * np.array([-1, -0.5, 0, 0.5, 1]), rtol=1e-9,
+                                   atol=1e-12 * peak)
         if mode == "axial":
             assert peak == pytest.approx(1e-4, rel=1e-12)  # the design's own mode: the first --amp
         rows = card_rows(design, 10, peak * 1e3 if mode in ("axial", "radial") else 0.1,
                          peak if mode in ("torsion", "conical") else 0.01, capsys)
         k = rows[mode]["stiffness_real"] + 1j * rows[mode]["stiffness_imag"]
         # the card's 12 digits against the file's 10: 2e-9 relative, and x̂ read to 10 digits
-        np.testing.assert_allclose(force, k.real * x, rtol=1e-8, atol=1e-9 * abs(k.real) * peak, err_msg=curve)
+        np.testing.assert_allclose(force, k.real * x, rtol=1e-8, atol=1e-9 * abs(k.real) * peak,
+                                   err_msg=curve)
         c = float(sections[damping]["keys"]["DAMPING"])
         assert c == pytest.approx(k.imag / omega, rel=1e-8), damping
         loss_factors.append(c * omega / (force[-1] / peak))
-    # K = S µ_eq(ω, ε) (eqs 16-18): at one equivalent strain every direction has the same loss factor
+    # K = S µ_eq(ω, ε) (eqs 16-18): at one equivalent strain, one loss factor in every direction
     np.testing.assert_allclose(loss_factors, loss_factors[0], rtol=1e-8)

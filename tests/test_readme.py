@@ -35,7 +35,7 @@ def test_ci_runs_the_readme_test_command():
     assert test in ci.splitlines()
 
 
-# ---- the worked examples: every `$ .venv/bin/bushing …` of the README's console blocks ----------
+# ---- the worked examples: every `$ .venv/bin/bushing …` of the README's console blocks --------
 
 CSV_HEADER = re.compile(r"[a-z_0-9]+(,[a-z_0-9]+)+")
 NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
@@ -164,7 +164,8 @@ def check_written(path: Path) -> None:
         assert len(rows) > 1 and all(len(r) == len(rows[0]) for r in rows), path.name
         for row in rows[1:]:
             for cell in row:
-                assert cell in ("axial", "radial", "torsion", "conical") or math.isfinite(float(cell))
+                assert cell in ("axial", "radial", "torsion", "conical") \
+                    or math.isfinite(float(cell)), path.name
     elif path.suffix == ".bdf":
         assert "PBUSH" in text and "ENDT" in text, path.name
     else:
@@ -177,11 +178,12 @@ def test_the_readme_shows_bushing_commands():
         assert shlex.split(command)[0] == ".venv/bin/bushing", command
 
 
-@pytest.mark.parametrize("command,shown", RUNS, ids=[f"{i}-{shlex.split(c)[1]}" for i, (c, _) in enumerate(RUNS)])
+@pytest.mark.parametrize("command,shown", RUNS,
+                         ids=[f"{i}-{shlex.split(c)[1]}" for i, (c, _) in enumerate(RUNS)])
 def test_a_readme_command_prints_what_the_readme_shows(command, shown, workdir):
     argv = [installed_bushing(), *shlex.split(command)[1:]]
-    done = subprocess.run(argv, cwd=workdir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                          check=False)
+    done = subprocess.run(argv, cwd=workdir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          text=True, check=False)
     assert done.returncode == 0, done.stdout
     printed = done.stdout.splitlines()
     if shown and CSV_HEADER.fullmatch(shown[0]):
