@@ -1,12 +1,15 @@
-"""Browser tests: the explorer served on a free port, driven by pytest-playwright in the
-system Chromium (Playwright's own browser download does not work here, so it is never used)."""
+"""Browser tests: the explorer served on a port the OS picks, driven by pytest-playwright in the
+system Chromium (Playwright's own browser download does not work here, so it is never used).
+
+Each test has its own server, page (pytest-playwright's context per test) and log window: no
+session, cache or log line of one test reaches another, whatever their order."""
 
 import logging
 import shutil
 
 import pytest
 
-from tests.helpers import free_port, wait_for
+from tests.helpers import served
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
@@ -40,11 +43,11 @@ class ServerLog(logging.Handler):
     def emit(self, record):
         self.records.append(record)
 
-    def tracebacks(self):
-        return [r for r in self.records if r.exc_info or "Traceback" in r.getMessage()]
+    def tracebacks(self, since: int = 0):
+        return [r for r in self.records[since:] if r.exc_info or "Traceback" in r.getMessage()]
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture
 def server_log():
     handler = ServerLog()
     logging.getLogger().addHandler(handler)
@@ -52,21 +55,15 @@ def server_log():
     logging.getLogger().removeHandler(handler)
 
 
-@pytest.fixture(scope="session")
-def explorer_url(server_log):
-    import panel as pn
-
+@pytest.fixture
+def explorer_url(page, server_log):
+    """The explorer on its own server for this test; the test's page is closed before the
+    server stops (a server stopping under an open page is not what a test looks at)."""
     from app.main import create_app
 
-    port = free_port()
-    server = pn.serve(
-        create_app, port=port, address="127.0.0.1", show=False, threaded=True, liveness=True,
-        websocket_origin=[f"127.0.0.1:{port}", f"localhost:{port}"], verbose=False,
-    )
-    url = f"http://127.0.0.1:{port}/"
-    wait_for(url + "liveness")
-    yield url
-    server.stop()
+    with served(create_app, verbose=False) as server:
+        yield f"http://localhost:{server.port}/"  # the origin Bokeh accepts by default
+        page.close()
 
 
 @pytest.fixture
@@ -79,9 +76,9 @@ def console_errors(page):
 
 
 @pytest.fixture
-def no_server_tracebacks(server_log):
+def no_server_tracebacks(explorer_url, server_log):
+    """No traceback logged by the server while the test ran (checked before its page closes)."""
     before = len(server_log.records)
     yield
-    new = server_log.records[before:]
-    tracebacks = [r for r in new if r.exc_info or "Traceback" in r.getMessage()]
+    tracebacks = server_log.tracebacks(since=before)
     assert tracebacks == [], [r.getMessage() for r in tracebacks]
