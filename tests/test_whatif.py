@@ -173,9 +173,20 @@ def test_elasticities_match_independent_finite_differences():
 
 
 def test_alpha_at_one_takes_a_one_sided_step():
+    """α = 1 is the end of its range: the step goes one way only, and still gives the derivative
+    of eq 5, ∂K/∂α = S m (iω)^α ln(iω) / 2 (S of eq 18 written out), so ∂|K|/∂ln α at α = 1 is
+    Re(K̄ ∂K/∂α)/|K| and ∂η/∂ln α is (Re K Im ∂K − Im K Re ∂K)/(Re K)²."""
     design = PAPER_B.replace(fractional_order=1.0)
     d = log_derivatives(design, 10.0, 1e-4, ("fractional_order",))
-    assert np.isfinite(d["fractional_order"][0]) and np.isfinite(d["fractional_order"][1])
+    a, b, L = (getattr(design.geometry, n) for n in ("inner_radius", "outer_radius", "length"))
+    iw = 2j * np.pi * 10.0
+    dk = 2 * np.pi * L / np.log(b / a) * design.material.fractional_coefficient * iw * np.log(iw) / 2
+    k = complex(stiffness_points(design, 10.0, 1e-4))
+    # a one-sided difference errs by about half the step (1e-4) times ∂²K/∂α² / ∂K/∂α = ln(iω)
+    # (|ln(iω)| ≈ 4.3): 2e-4 relative; 2e-3 leaves room and catches a two-sided step's NaN or 0
+    assert float(d["fractional_order"][0]) == pytest.approx((np.conj(k) * dk).real / abs(k), rel=2e-3)
+    assert float(d["fractional_order"][1]) == pytest.approx((k.real * dk.imag - k.imag * dk.real) / k.real**2,
+                                                            rel=2e-3)
 
 
 def test_the_sentence_names_what_dominates():
