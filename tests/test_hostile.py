@@ -1,6 +1,8 @@
-"""Hostile input to the command line: every case ends with exit status 2 (or 1 for a result the
-formulas cannot give) and one line on standard error; never a traceback, a warning, a hang or a
-NaN in an output."""
+"""Hostile input to the command line, through the installed entry point in a subprocess: bad
+input ends with exit status 2 and one line on standard error naming what is wrong; valid input,
+however odd, gives a clean result; never a traceback, a warning or a NaN in an output.
+
+HANG_GUARD_S only stops a run that hangs: it is no speed check (a slow machine passes)."""
 
 import json
 import subprocess
@@ -17,9 +19,12 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 DESIGN = json.loads((EXAMPLES / "paper_b_true.json").read_text())
 
 
-def bushing(*argv, stdout=subprocess.PIPE, timeout=60):
+HANG_GUARD_S = 900  # each run takes seconds; only a hang takes a quarter of an hour
+
+
+def bushing(*argv, stdout=subprocess.PIPE):
     return subprocess.run([sys.executable, "-m", "app.cli", *map(str, argv)], stdout=stdout,
-                          stderr=subprocess.PIPE, text=True, timeout=timeout, check=False)
+                          stderr=subprocess.PIPE, text=True, timeout=HANG_GUARD_S, check=False)
 
 
 def design_file(tmp_path, text, name="d.json"):
@@ -92,7 +97,6 @@ def test_hostile_measured_files(tmp_path):
     good = [(f, a, 4.2e6, 0.14) for f in (1, 10, 100) for a in (1e-5, 1e-4, 1e-3)]
     cases = {
         "an amplitude of 1e300": ([*good, (10, 1e300, 4e6, 0.1)], "amplitude"),
-        "a negative loss factor": ([*good, (10, 1e-4, 4e6, -0.1)], "negative loss factor"),
         "a frequency of 1e300 Hz": ([*good, (1e300, 1e-4, 4e6, 0.1)], "frequency_hz must be within"),
         "an amplitude of 1e-20 m": ([*good, (10, 1e-20, 4e6, 0.1)], "at least"),
     }
@@ -102,6 +106,30 @@ def test_hostile_measured_files(tmp_path):
             r = bushing(command, path, "--design", design)
             assert r.returncode == 2 and r.stdout == "", (case, command, r.stderr)
             assert r.stderr.count("\n") == 1 and needle in r.stderr, (case, command, r.stderr)
+
+
+def test_a_stiffness_of_any_sign_is_fitted_and_diagnosed(tmp_path):
+    """A negative loss factor (a blocked transfer stiffness above a wave resonance) and Re K < 0
+    (a mass-dominated one) are measurements, not errors: fit and diagnose read them and finish."""
+    measured = (EXAMPLES / "paper_b_stiffness.csv").read_text()
+    rows = measured.count("\n")  # the header and the file's rows, one of them added below
+    files = {"a negative loss factor": measured + "800,0.008,7950.23,-0.0075\n"}
+    header, _, body = measured.partition("\n")
+    assert header == "frequency_hz,amplitude,magnitude,loss_factor", header
+    polar = [[float(c) for c in line.split(",")] for line in body.splitlines()]
+    files["Re K < 0"] = "frequency_hz,amplitude,stiffness_real,stiffness_imag\n" + "".join(
+        f"{f!r},{a!r},{m / np.hypot(1, eta):.17g},{m * eta / np.hypot(1, eta):.17g}\n" for f, a, m, eta in polar
+    ) + "1000,1e-4,-2500000,300000\n"
+    for case, text in files.items():
+        path = tmp_path / "m.csv"
+        path.write_text(text)
+        for command in ("fit", "diagnose"):
+            r = bushing(command, path, "--design", EXAMPLES / "paper_b_true.json")
+            assert r.returncode == 0, (case, command, r.stderr)
+            assert all(line.startswith("bushing fit: warning: ") for line in r.stderr.splitlines()), r.stderr
+            report = json.loads(r.stdout, parse_constant=lambda c: pytest.fail(f"{c} in a report"))
+            points = report["fit"]["points"] if command == "fit" else report["points"]
+            assert points == rows, (case, command, points)
 
 
 def _loop_rows(change):
@@ -118,7 +146,8 @@ LOOPS = {
     "a third of a period": (lambda t, x, f: (t[:67], x[:67], f[:67]), "period"),
     "a drive that is no sine": (lambda t, x, f: (t, np.sign(np.sin(37 * t)) * np.abs(x) ** 0.5 * 1e-2, f),
                                 "not a steady sine"),
-    "a force of 1e300 N": (lambda t, x, f: (t, x, f * 1e300), None),
+    # 1e302 N at 0.1 mm: no bushing; the message names the force (a fit would only fail)
+    "a force of 1e300 N": (lambda t, x, f: (t, x, f * 1e300), "force"),
 }
 
 
@@ -130,12 +159,6 @@ def test_hostile_loop_files(case, tmp_path):
     path.write_text("time_s,displacement,force\n" + "".join(f"{a:.17g},{b:.17g},{c:.17g}\n" for a, b, c in zip(t, x, f)))
     r = bushing("fit", EXAMPLES / "paper_b_stiffness.csv", "--design", EXAMPLES / "paper_b_guess.json", "--loop", path)
     assert "Traceback" not in r.stderr and "internal error" not in r.stderr, (case, r.stderr)
-    if needle is None:  # a valid file: a finite fit, or one clear line
-        if r.returncode == 0:
-            json.loads(r.stdout, parse_constant=lambda c: pytest.fail(f"{c} in the fit file"))
-        else:
-            assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
-        return
     assert r.returncode == 2 and r.stdout == "", (case, r.stderr)
     assert r.stderr.count("\n") == 1 and needle in r.stderr, (case, r.stderr)
 
@@ -147,22 +170,19 @@ def test_a_full_standard_output_is_a_message_not_a_traceback():
 
 
 def test_a_fit_to_one_point_repeated_writes_valid_json(tmp_path):
-    """150 copies of one point cannot determine five parameters: whatever the fit says, its
-    file is strict JSON (no NaN, no Infinity)."""
+    """150 copies of one point cannot determine five parameters, but they are valid data: the fit
+    finishes, says which parameters are undetermined, and its file is strict JSON."""
     k = 4.2e6 * (1 + 0.14j) / np.sqrt(1 + 0.14**2)
     data = MeasuredStiffness(np.full(150, 10.0), np.full(150, 1e-4), np.full(150, k))
     data.to_csv(tmp_path / "same.csv")
     r = bushing("fit", tmp_path / "same.csv", "--design", EXAMPLES / "paper_b_true.json")
-    assert "Traceback" not in r.stderr and "Warning" not in r.stderr
-    if r.returncode == 0:
-        report = json.loads(r.stdout, parse_constant=lambda c: pytest.fail(f"{c} in the fit file"))
-        assert set(report["fit"]["standard_errors"]) == {"shear_modulus", "fractional_coefficient", "fractional_order",
-                                                          "friction_stress_max", "friction_strain_half"}
-        # one point is two numbers: at least three of the five parameters stay undetermined
-        assert len(report["fit"]["undetermined"]) >= 3
-        assert all(line.startswith("bushing fit: warning: ") for line in r.stderr.splitlines())
-    else:
-        assert r.returncode == 2 and r.stderr.count("\n") == 1
+    assert r.returncode == 0, r.stderr
+    report = json.loads(r.stdout, parse_constant=lambda c: pytest.fail(f"{c} in the fit file"))
+    assert set(report["fit"]["standard_errors"]) == {"shear_modulus", "fractional_coefficient", "fractional_order",
+                                                      "friction_stress_max", "friction_strain_half"}
+    # one point is two numbers: at least three of the five parameters stay undetermined
+    assert len(report["fit"]["undetermined"]) >= 3
+    assert all(line.startswith("bushing fit: warning: ") for line in r.stderr.splitlines())
 
 
 def test_no_warning_reaches_the_user_on_success(tmp_path):
