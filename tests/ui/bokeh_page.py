@@ -64,9 +64,15 @@ READY_JS = f"""(titles) => {{
   return titles.every(t => {{ const m = ({FIGURE_JS})(t); return m !== null && summary(m).points > 0; }});
 }}"""
 
-# every view's pending work done: Bokeh chains each view's repaints and signal handlers on its
-# `ready` promise
-SETTLED_JS = "async () => { await Promise.all([...Bokeh.index.all_views()].map(v => v.ready)); return true; }"
+# start waiting for every view's pending work: Bokeh chains each view's repaints and signal
+# handlers on its `ready` promise; the page counts the waits that have ended
+SETTLE_JS = """() => {
+  const token = window.bushingSettleAsked = (window.bushingSettleAsked ?? 0) + 1;
+  Promise.all([...Bokeh.index.all_views()].map(v => v.ready)).then(() => {
+    window.bushingSettled = Math.max(window.bushingSettled ?? 0, token);
+  });
+  return token;
+}"""
 
 LOAD_TIMEOUT_MS = 60_000
 
@@ -76,9 +82,10 @@ def plots(page) -> dict:
     return page.evaluate(PLOTS_JS)
 
 
-def settle(page):
-    """Wait until every Bokeh view has painted what it has received."""
-    page.evaluate(SETTLED_JS)
+def settle(page, timeout=30_000):
+    """Wait until every Bokeh view has painted what it had received when this was called."""
+    token = page.evaluate(SETTLE_JS)
+    page.wait_for_function("(token) => window.bushingSettled >= token", arg=token, timeout=timeout)
 
 
 def wait_ready(page, titles=EXPLORER_TITLES, timeout=LOAD_TIMEOUT_MS):

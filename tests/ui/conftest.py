@@ -8,10 +8,14 @@ import logging
 import shutil
 
 import pytest
+from playwright.sync_api import expect
 
 from tests.helpers import served
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+# expect(...) waits for its condition as long as page.wait_for_* does (its own default, 5 s, is
+# shorter than an update takes on a loaded machine)
+expect.set_options(timeout=30_000)
 
 
 @pytest.fixture(scope="session")
