@@ -26,14 +26,23 @@ from scipy import special
 from .design import MODES, DesignError, Material, _number
 from .material import REFERENCE_FREQUENCY_HZ, fractional_modulus, friction_modulus
 
+# the modes whose drive is an angle (core.bushing.UNITS): a mass there is a moment of inertia
+ROTATIONS = ("torsion", "conical")
+
 
 @dataclass(frozen=True)
 class Parameter:
     name: str
-    unit: str  # "axial/torsion" where the unit depends on the mode
+    unit: str  # its unit; for a parameter whose unit depends on the mode, in the translations
     meaning: str
     bounds: tuple[float, float] = (0.0, math.inf)  # the range searched when fitting
     log: bool = True  # fitted as its logarithm (a scale), or as itself
+    rotation_unit: str | None = None  # its unit in the rotations (ROTATIONS), if not ``unit``
+
+    def unit_in(self, mode: str) -> str:
+        """The parameter's one unit in ``mode``: an apparent mass is in kg in axial and radial
+        (translations), in kg·m² in torsion and conical (rotations)."""
+        return self.rotation_unit if self.rotation_unit and mode in ROTATIONS else self.unit
 
 
 @dataclass(frozen=True)
@@ -110,7 +119,8 @@ EFFECTS: dict[str, Effect] = {
         Effect(
             "inertia",
             "Apparent mass seen by the force sensor",
-            (Parameter("mass", "kg/kg·m²", "apparent mass M (kg axially, kg·m² in torsion)", (1e-12, 1e4)),),
+            (Parameter("mass", "kg", "apparent mass M (a moment of inertia in torsion and conical)",
+                       (1e-12, 1e4), rotation_unit="kg·m²"),),
             "Mass between the rubber and the force sensor (fixture, part of the rubber) is "
             "accelerated with the drive; its inertial force adds to the rubber's.",
             "Measured stiffness falls below the model more and more at high frequency, as ω², "
@@ -185,6 +195,32 @@ def split_id(eid: str) -> tuple[str, str | None]:
 def effect_of(eid: str) -> Effect:
     """The library's effect behind an id, mode-tied or not (:func:`split_id`)."""
     return EFFECTS[split_id(eid)[0]]
+
+
+# µ's fitting range, far wider than any rubber (it keeps the search finite); the other
+# parameters carry theirs in the effect library
+SHEAR_MODULUS = Parameter("shear_modulus", "Pa", "shear modulus µ", (1e2, 1e11))
+
+
+def parameter(name: str) -> Parameter:
+    """The fitting range and scale of a parameter: a material name, or ``effect_id.name``."""
+    if name == "shear_modulus":
+        return SHEAR_MODULUS
+    eid, _, pname = name.rpartition(".")
+    base = split_id(eid)[0]
+    owners = [EFFECTS[base]] if base in EFFECTS else [] if eid else [EFFECTS["friction"], EFFECTS["fractional"]]
+    for effect in owners:
+        for p in effect.parameters:
+            if p.name == pname:
+                return p
+    raise ValueError(f"unknown parameter {name!r}")
+
+
+def parameter_unit(name: str, mode: str) -> str:
+    """The unit of a parameter (its fitting name) in a design of ``mode``: a rig effect tied to
+    another mode (``inertia@torsion.mass``) is in that mode's unit."""
+    tied = split_id(name.rpartition(".")[0])[1]
+    return parameter(name).unit_in(tied or mode)
 
 
 def validate_effects(effects: Any) -> dict[str, dict[str, float]]:
@@ -274,7 +310,7 @@ def extended_modulus(material: Material, effects: Mapping, frequency_hz, strain_
 
 
 def inertia_correction(stiffness, frequency_hz, mass: float):
-    """K_measured = K − ω² M (M in kg axially, kg·m² in torsion)."""
+    """K_measured = K − ω² M (M in kg in axial and radial, kg·m² in torsion and conical)."""
     omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
     return stiffness - omega**2 * mass
 

@@ -30,14 +30,13 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from .bushing import check_measured_amplitude, loop_force, stiffness_points
 from .data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from .design import Design, as_dict
-from .effects import EFFECTS, Parameter, split_id
+from .effects import Parameter, parameter, parameter_unit
 from .shape import OutsideTable
-from .uncertainty import CONFIDENCE, profile
+from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS, linearised, minimise, profile
 
 PARAMETERS = (
     "shear_modulus",
@@ -46,23 +45,9 @@ PARAMETERS = (
     "friction_stress_max",
     "friction_strain_half",
 )
-# µ's fitting range, far wider than any rubber (it keeps the search finite); the other
-# parameters carry theirs in the effect library
-SHEAR_MODULUS = Parameter("shear_modulus", "Pa", "shear modulus µ", (1e2, 1e11))
-
-
-def parameter(name: str) -> Parameter:
-    """The fitting range and scale of a parameter: a material name, or ``effect_id.name``."""
-    if name == "shear_modulus":
-        return SHEAR_MODULUS
-    eid, _, pname = name.rpartition(".")
-    base = split_id(eid)[0]
-    owners = [EFFECTS[base]] if base in EFFECTS else [] if eid else [EFFECTS["friction"], EFFECTS["fractional"]]
-    for effect in owners:
-        for p in effect.parameters:
-            if p.name == pname:
-                return p
-    raise ValueError(f"unknown parameter {name!r}")
+FIT_NFEV = (100, 100, 200)  # iterations from one start in the stages of uncertainty.minimise
+# a relative misfit beyond this is no fit, and its squares would overflow: not evaluable
+MAX_RESIDUAL = 1e100
 
 
 def parameter_values(design: Design) -> dict[str, float]:
@@ -232,10 +217,15 @@ class _Problem:
             self.loop_weight = math.sqrt(max(n_k, loop.force.size) / loop.force.size) * np.sqrt(count)
 
     def to_theta(self, values: dict) -> np.ndarray:
-        return np.array([math.log(values[p]) if s.log else values[p] for p, s in zip(self.free, self.specs)])
+        """Fitted coordinates of ``values``, each clipped into its fitting range first (a design's
+        mass of 1e300 kg or of 0 starts the search at the end of the range)."""
+        clipped = [float(np.clip(values[p], *s.bounds)) for p, s in zip(self.free, self.specs)]
+        return np.array([math.log(v) if s.log else v for v, s in zip(clipped, self.specs)])
 
     def values(self, theta) -> dict[str, float]:
-        return {p: math.exp(t) if s.log else float(t) for p, s, t in zip(self.free, self.specs, theta)}
+        """Natural values of fitted coordinates, within the fitting ranges (exp(ln 10) is a hair
+        above 10, which ε½'s range refuses)."""
+        return {p: float(np.clip(math.exp(t) if s.log else t, *s.bounds)) for p, s, t in zip(self.free, self.specs, theta)}
 
     def model(self, theta) -> Design:
         return with_values(self.design, self.values(theta))
@@ -255,33 +245,20 @@ class _Problem:
         if self.loop is not None:
             f = sum(loop_force(design, self.loop_f, self.loop_amp, self.loop_phase))
             parts.append(self.loop_weight * (f - self.loop_force) / self.loop_scale)
-        return np.concatenate(parts)
+        r = np.concatenate(parts)
+        return np.where(np.abs(r) <= MAX_RESIDUAL, r, np.inf)  # NaN too: not evaluable there
 
 
 def _uncertainties(problem: _Problem, sol) -> tuple[dict, dict, np.ndarray]:
-    n, p = sol.fun.size, len(problem.free)
-    dof = max(n - p, 1)
-    s2 = 2.0 * sol.cost / dof
-    jtj = sol.jac.T @ sol.jac
-    try:
-        cov = s2 * np.linalg.inv(jtj)
-    except np.linalg.LinAlgError:
-        cov = s2 * np.linalg.pinv(jtj)
-    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    values = problem.values(sol.x)
-    errors = {}
-    for i, (name, spec) in enumerate(zip(problem.free, problem.specs)):
-        errors[name] = float(values[name] * sd[i] if spec.log else sd[i])  # delta method
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = cov / np.outer(sd, sd)
-    correlation = {a: {b: float(np.round(corr[i, j], 12)) for j, b in enumerate(problem.free)}
-                   for i, a in enumerate(problem.free)}
-    return errors, correlation, sd
+    logs = [spec.log for spec in problem.specs]
+    return linearised(sol.jac, 2.0 * sol.cost, problem.free, problem.values(sol.x), logs)
 
 
 def _starts(problem: _Problem, n: int, seed: int = 0) -> list[np.ndarray]:
-    """The design's own values first, then a seeded Latin-hypercube spread around them:
-    moduli and ε½ within a factor 10 either way, α across (0.05, 0.8)."""
+    """The design's own values first (clipped into their fitting ranges), then a seeded
+    Latin-hypercube spread around them: moduli and ε½ within a factor 10 either way, α across
+    (0.05, 0.8), an effect's parameters across their whole fitting range (a design's mass of 0
+    or 1e300 kg says nothing about where to look)."""
     first = problem.to_theta(problem.base)
     if n <= 1:
         return [first]
@@ -294,12 +271,15 @@ def _starts(problem: _Problem, n: int, seed: int = 0) -> list[np.ndarray]:
         theta = []
         for j, (name, spec) in enumerate(zip(problem.free, problem.specs)):
             u = cols[j][k]
+            lo, hi = (math.log(b) for b in spec.bounds) if spec.log else spec.bounds
             if name == "fractional_order":
                 theta.append(0.05 + 0.75 * u)
+            elif "." in name:  # an effect's
+                theta.append(lo + (hi - lo) * u)
             elif spec.log:
                 theta.append(first[j] + math.log(10.0) * (2 * u - 1))
             else:
-                theta.append(spec.bounds[0] + (spec.bounds[1] - spec.bounds[0]) * u)
+                theta.append(lo + (hi - lo) * u)
         starts.append(np.array(theta))
     return starts
 
@@ -310,14 +290,15 @@ def _solve(problem: _Problem, starts: list[np.ndarray]):
     for theta0 in starts:
         theta0 = np.clip(theta0, lo, hi)
         try:
-            sol = least_squares(problem.residuals, theta0, bounds=(lo, hi), method="trf",
-                                x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=400)
+            sol, _ = minimise(problem.residuals, theta0, lo, hi, FIT_NFEV, xtol=1e-12)
         except (ValueError, FloatingPointError, OverflowError):
             continue  # a start the model cannot evaluate: try the next
         if np.all(np.isfinite(sol.fun)) and (best is None or sol.cost < best.cost):
             best = sol
     if best is None:
-        raise ValueError("the fit failed from every starting point (check the data and the design)")
+        raise ValueError(f"the fit failed from every starting point: the model cannot be evaluated there, or "
+                         f"misses the data by more than {MAX_RESIDUAL:.0e} times (check the data and the "
+                         f"design: its mode, geometry and the values of what is not fitted)")
     return best
 
 
@@ -331,7 +312,7 @@ def fitted_name(name: str | None) -> str | None:
 def _profiled(problem: _Problem, sol):
     """Profile every free parameter; if the walk finds a lower misfit than the optimum (the
     search was not global), refit from there and profile again. The solution, its intervals in
-    natural units and whether the profile finished in its time."""
+    natural units and whether the profile finished within its count of evaluations."""
     lo, hi = problem.bounds()
     for _ in range(3):
         sd = _uncertainties(problem, sol)[2]
@@ -349,6 +330,24 @@ def _profiled(problem: _Problem, sol):
     return sol, intervals, prof.complete
 
 
+def _unit_words(name: str, mode: str) -> str:
+    """" kg" after a value of ``name`` in ``mode``; nothing after a pure number."""
+    unit = parameter_unit(name, mode)
+    return "" if unit == "–" else f" {unit}"
+
+
+def _pushed(spec: Parameter, x: float, interval, edge: str, span: float) -> bool:
+    """Whether the data push a parameter at the ``edge`` of its fitting range against it: its
+    profile excludes values a tenth of the range away (else the data do not see it there, as a
+    mass of 1e-12 kg, and it is merely not determined)."""
+    if interval is None:
+        return True  # not profiled: the edge is all that is known
+    inner = interval[1] if edge == "lower" else interval[0]  # the side away from the edge
+    if inner is None:
+        return False
+    return abs((math.log(inner) if spec.log else inner) - x) <= span / 10
+
+
 def _warnings(problem: _Problem, sol, intervals: dict, complete: bool) -> tuple[str, ...]:
     """Plain words for what the user must know about a fit: parameters driven to the end of
     their fitting range, parameters the data do not determine, an unfinished profile."""
@@ -358,22 +357,22 @@ def _warnings(problem: _Problem, sol, intervals: dict, complete: bool) -> tuple[
     for i, (name, spec) in enumerate(zip(problem.free, problem.specs)):
         span = hi[i] - lo[i]
         edge = "lower" if sol.x[i] - lo[i] <= 1e-6 * span else "upper" if hi[i] - sol.x[i] <= 1e-6 * span else None
-        if edge:
+        if edge and _pushed(spec, sol.x[i], intervals.get(name), edge, span):
             at_edge.add(name)
-            unit = "" if spec.unit == "–" else f" {spec.unit}"
+            unit = _unit_words(name, problem.design.mode)
             out.append(f"{name} ran to the {edge} end of its fitting range ({values[name]:.3g}{unit}): "
                        f"the model cannot follow these data there; check that the design's mode and "
                        f"geometry are those of the measurement")
     for name, (a, b) in intervals.items():
         if (a is None or b is None) and name not in at_edge:
-            unit = parameter(name).unit
-            unit = "" if unit == "–" else f" {unit}"
+            unit = _unit_words(name, problem.design.mode)
             which = ("any value in its fitting range" if a is None and b is None
                      else f"any value up to {b:.3g}{unit}" if a is None else f"any value from {a:.3g}{unit} up")
             out.append(f"{name} is not determined by these data: {which} fits them as well "
                        f"({CONFIDENCE:.0%} profile); measure more amplitudes or frequencies to pin it down")
     if not complete:
-        out.append("the profile intervals are incomplete: the time limit stopped the walk (unfinished sides are open)")
+        out.append(f"the profile intervals are incomplete: a side spent its {SIDE_EVALUATIONS} evaluations "
+                   f"of the model before the end (unfinished sides are open)")
     return tuple(out)
 
 

@@ -16,26 +16,42 @@ parameter there. A parameter with an open side is *not determined* by the data.
 
 Everything here works on the fitted coordinates (logarithms for positive parameters), on a
 residual function of all of them, with their bounds.
+
+The work is bounded by counts, never by the clock, so that a result does not depend on the
+machine: a side takes at most :data:`MAX_STEPS` outward steps (enough to reach the end of the
+fitting range from the smallest first step) and :data:`BISECTIONS` refinements; a refit at most
+:data:`REFIT_NFEV` iterations; and a side at most :data:`SIDE_EVALUATIONS` evaluations of the
+residuals. A side that spends them before it crosses the threshold is left open, and the
+profile says it is not complete.
 """
 
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
+from scipy.optimize import OptimizeResult, least_squares
 from scipy.stats import f as f_distribution
 
 CONFIDENCE = 0.95
 # the smallest residual scale trusted (relative error): exact or noise-free data still get
 # intervals of a meaningful width rather than of round-off
 NOISE_FLOOR = 1e-4
-MAX_STEPS = 40  # outward steps per side (each doubles the step, capped at a tenth of the range)
+FIRST_STEP = (1e-6, 1 / 20)  # the first step's least and largest, as fractions of the range
+LONGEST_STEP = 1 / 10  # steps double up to this fraction of the range
+# doubling from the least first step reaches the longest step in 17 steps, which then reach the
+# end of the range in at most 10 more: a side never needs more
+MAX_STEPS = math.ceil(math.log2(LONGEST_STEP / FIRST_STEP[0])) + round(1 / LONGEST_STEP) + 1
 BISECTIONS = 4  # refinements of a crossing
-TIME_LIMIT_S = 60.0  # all profiles of one fit together
+# a refit's iterations in the stages of minimise (evaluations, the Jacobian's not counted): a
+# warm-started refit of these models converges in fewer than 20 trf iterations, or stalls
+REFIT_NFEV = (20, 40, 100)
+# residual evaluations of one side of a profile: the sides of the examples' fits and diagnoses,
+# absurd designs' included, take at most about 1600; at under a millisecond each (a fit's binned
+# points) a side takes at most a few seconds
+SIDE_EVALUATIONS = 3000
 
 
 @dataclass(frozen=True)
@@ -47,14 +63,85 @@ class Profile:
     intervals: list[tuple[float | None, float | None]]
     better: np.ndarray | None
     threshold: float  # allowed rise of the sum of squares
-    complete: bool  # False if the time limit stopped the walk (unfinished sides are open)
+    complete: bool  # False if a side spent its SIDE_EVALUATIONS first (that side is open)
+    evaluations: int = 0  # of the residuals, the whole profile
+
+
+class _Exhausted(Exception):
+    """A side has spent its evaluations."""
+
+
+def minimise(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, iterations: tuple[int, int, int], *,
+             xtol: float, allowance: int | None = None) -> tuple[OptimizeResult | None, bool]:
+    """Bounded least squares of ``fun`` from ``x0``, each stage bounded by its ``iterations``
+    (function evaluations, the Jacobian's not counted): trust-region reflective; if it has not
+    converged, dogbox from where it stopped; if that has not converged to a lower sum of squares
+    either, trust-region reflective again from the better point. The best point of the stages.
+
+    trf creeps, a tiny step at a time, when a parameter that no longer acts lies against its
+    bound (a mass of 1e-12 kg): dogbox holds such a parameter on the bound and converges in a
+    few iterations; but dogbox alone may stop in a worse minimum, which the last stage leaves.
+
+    With ``allowance``, at most that many evaluations of ``fun`` in all (an iteration and its
+    finite-difference Jacobian cost at most 1 + len(x0)). Returns the solution and whether the
+    allowance cut an unconverged search short (the solution None if nothing was allowed).
+    Raises ValueError where ``fun`` is not finite at ``x0``."""
+    spent = [0]
+
+    def counted(x):
+        spent[0] += 1
+        return fun(x)
+
+    def stage(method, x, most):
+        allowed = most if allowance is None else min(most, (allowance - spent[0]) // (np.size(x0) + 1))
+        if allowed < 1:
+            return None, True
+        sol = least_squares(counted, x, bounds=(lower, upper), method=method, x_scale="jac", xtol=xtol,
+                            ftol=1e-12, gtol=1e-12, max_nfev=allowed)
+        return sol, sol.status == 0 and allowed < most
+
+    first, cut = stage("trf", np.asarray(x0, dtype=float), iterations[0])
+    if first is None or first.status != 0 or cut:
+        return first, cut
+    second, cut = stage("dogbox", first.x, iterations[1])
+    if second is None:
+        return first, True
+    better = second if second.cost < first.cost else first
+    if (second.status != 0 and better is second) or cut:
+        return better, cut
+    third, cut = stage("trf", better.x, iterations[2])
+    if third is None:
+        return better, True
+    return (third if third.cost < better.cost else better), cut and third.status == 0
+
+
+def linearised(jac: np.ndarray, sum_of_squares: float, names, values: dict[str, float],
+               logs) -> tuple[dict, dict, np.ndarray]:
+    """The linearised uncertainties at an optimum: cov = s² (JᵀJ)⁻¹ with s² the residual
+    variance; the standard errors in natural units (the delta method, for a parameter fitted as
+    its logarithm when ``logs`` says so), the correlations, and the standard deviations in
+    fitted coordinates."""
+    dof = max(jac.shape[0] - len(names), 1)
+    s2 = sum_of_squares / dof
+    jtj = jac.T @ jac
+    try:
+        cov = s2 * np.linalg.inv(jtj)
+    except np.linalg.LinAlgError:
+        cov = s2 * np.linalg.pinv(jtj)
+    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    errors = {name: float(values[name] * sd[i] if log else sd[i]) for i, (name, log) in enumerate(zip(names, logs))}
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(sd, sd)
+    correlation = {a: {b: float(np.round(corr[i, j], 12)) for j, b in enumerate(names)} for i, a in enumerate(names)}
+    return errors, correlation, sd
 
 
 def profile(residuals: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, lower, upper,
-            step, *, confidence: float = CONFIDENCE, time_limit: float = TIME_LIMIT_S) -> Profile:
+            step, *, confidence: float = CONFIDENCE, evaluations: int = SIDE_EVALUATIONS) -> Profile:
     """Profile every parameter of the least-squares problem ``residuals`` about its optimum
     ``theta`` within the bounds; ``step`` gives each parameter's first step (for example its
-    linearised standard error, in the same coordinates)."""
+    linearised standard error, in the same coordinates). At most ``evaluations`` evaluations of
+    ``residuals`` per side, and one at the optimum."""
     theta = np.asarray(theta, dtype=float)
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     r0 = residuals(theta)
@@ -63,33 +150,47 @@ def profile(residuals: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, lo
     dof = max(n - p, 1)
     s2 = max(s_min / dof, NOISE_FLOOR**2)
     threshold = s2 * float(f_distribution.ppf(confidence, 1, dof))
-    deadline = time.monotonic() + time_limit
-    walker = _Walker(residuals, theta, lower, upper, s_min, threshold, deadline)
-    intervals = []
+    walker = _Walker(residuals, theta, lower, upper, s_min, threshold)
+    intervals, complete = [], True
     for j in range(p):
         sides = []
         for direction in (-1.0, 1.0):
-            sides.append(walker.side(j, direction, _first_step(step[j], upper[j] - lower[j])))
+            walker.allow(evaluations)
+            try:
+                sides.append(walker.side(j, direction, _first_step(step[j], upper[j] - lower[j])))
+            except _Exhausted:
+                sides.append(None)
+                complete = False
         intervals.append((sides[0], sides[1]))
-    return Profile(intervals, walker.better, threshold, not walker.late)
+    return Profile(intervals, walker.better, threshold, complete, walker.spent + 1)
 
 
 def _first_step(step: float, span: float) -> float:
     step = abs(float(step)) if math.isfinite(step) else span
-    return float(np.clip(step, span * 1e-6, span / 20))
+    return float(np.clip(step, span * FIRST_STEP[0], span * FIRST_STEP[1]))
 
 
 class _Walker:
-    def __init__(self, residuals, theta, lower, upper, s_min, threshold, deadline):
+    def __init__(self, residuals, theta, lower, upper, s_min, threshold):
         self.residuals, self.theta, self.lower, self.upper = residuals, theta, lower, upper
-        self.s_min, self.threshold, self.deadline = s_min, threshold, deadline
+        self.s_min, self.threshold = s_min, threshold
         self.better: np.ndarray | None = None
         self.best_s = s_min
-        self.late = False
+        self.spent = 0  # evaluations of the residuals, every side
+        self.left = 0  # of the current side's evaluations
+
+    def allow(self, evaluations: int) -> None:
+        """Start a side that may spend ``evaluations``."""
+        self.left = evaluations
+
+    def _charge(self, evaluations: int) -> None:
+        self.spent += evaluations
+        self.left -= evaluations
 
     def refit(self, j: int, value: float, starts: list[np.ndarray]) -> tuple[float, np.ndarray]:
         """The sum of squares with parameter ``j`` held at ``value``, the others refitted (from
-        each of ``starts``, the best kept); the others' values."""
+        each of ``starts``, the best kept); the others' values. Raises :class:`_Exhausted` when
+        the side's evaluations run out before a refit has converged."""
         others = np.arange(self.theta.size) != j
 
         def full(x):
@@ -99,17 +200,29 @@ class _Walker:
 
         best = (math.inf, starts[0])
         for x0 in starts:
+            if self.left < 1:
+                raise _Exhausted
             if not others.any():
                 r = self.residuals(full(x0))
+                self._charge(1)
                 s, x = float(r @ r), x0
             else:
                 lo, hi = self.lower[others], self.upper[others]
+                spent = [0]
+
+                def fun(x, spent=spent):
+                    spent[0] += 1
+                    return self.residuals(full(x))
+
                 try:
-                    sol = least_squares(lambda x: self.residuals(full(x)), np.clip(x0, lo, hi),
-                                        bounds=(lo, hi), method="trf", x_scale="jac", xtol=1e-10,
-                                        ftol=1e-12, gtol=1e-12, max_nfev=200)
+                    sol, cut = minimise(fun, np.clip(x0, lo, hi), lo, hi, REFIT_NFEV, xtol=1e-10,
+                                           allowance=self.left)
                 except (ValueError, ArithmeticError):
+                    self._charge(spent[0])
                     continue
+                self._charge(spent[0])
+                if cut:
+                    raise _Exhausted
                 if not np.all(np.isfinite(sol.fun)):
                     continue
                 s, x = 2.0 * float(sol.cost), sol.x
@@ -123,7 +236,7 @@ class _Walker:
 
     def side(self, j: int, direction: float, step: float) -> float | None:
         """Where the profile of parameter ``j`` crosses the threshold going ``direction`` from the
-        optimum; ``None`` if it does not before the bound (or before the time runs out)."""
+        optimum; ``None`` if it does not before the bound."""
         others = np.arange(self.theta.size) != j
         x_hat = self.theta[others]
         edge = self.lower[j] if direction < 0 else self.upper[j]
@@ -132,9 +245,6 @@ class _Walker:
         for _ in range(MAX_STEPS):
             if abs(edge - inside) <= 1e-12 * max(span, 1.0):
                 return None  # the optimum sits at the bound: nothing beyond it to test
-            if time.monotonic() > self.deadline:
-                self.late = True
-                return None
             value = inside + direction * step
             at_edge = direction * (value - edge) >= 0
             if at_edge:
@@ -146,16 +256,20 @@ class _Walker:
             inside, x_in, rise_in = value, x, max(rise, 0.0)
             if at_edge:
                 return None
-            step = min(2.0 * step, span / 10)
+            step = min(2.0 * step, span * LONGEST_STEP)
         return None
 
     def _crossing(self, j, inner, outer, x_hat) -> float:
         """Bisect between a point inside and one outside, then interpolate the signed root
-        sqrt(rise), which is linear in a parameter the model is linear in."""
+        sqrt(rise), which is linear in a parameter the model is linear in. The side's evaluations
+        spent during the bisection end it: the crossing is interpolated in the bracket reached."""
         (a, xa, ra), (b, _, rb) = inner, outer
         for _ in range(BISECTIONS):
             mid = 0.5 * (a + b)
-            s, x = self.refit(j, mid, [xa, x_hat])
+            try:
+                s, x = self.refit(j, mid, [xa, x_hat])
+            except _Exhausted:
+                break
             rise = s - self.s_min
             if rise > self.threshold:
                 b, rb = mid, rise
