@@ -173,9 +173,8 @@ class DiagnosisView(pn.viewable.Viewer):
         ]
         for n, step in enumerate(r.steps, 1):
             params = ", ".join(f"{k} = {v:.4g}" + (f" ± {step.standard_errors[k]:.2g}"
-                                                   if np.isfinite(step.standard_errors.get(k, np.nan)) else "")
-                               + ("" if step.units.get(k, "–") == "–" else f" {step.units[k]}")  # the mode's
-                               + (" (not determined)" if k in step.undetermined else "")
+                                                   if np.isfinite(step.standard_errors.get(k, np.nan)) else
+                                                   " (not determined)" if k in step.undetermined else "")
                                for k, v in step.parameters.items()) or "no parameters"
             partner = step.extra.get("found_with")
             together = f" (found together with {partner})" if partner else ""

@@ -201,18 +201,16 @@ def test_a_mass_is_in_kg_in_translations_and_kg_m2_in_rotations():
     assert parameter_unit("viscous.viscosity", "torsion") == "Pa·s"
 
 
-@pytest.mark.parametrize("design, mass, unit", [
-    (PAPER_B, 0.5, "kg"),  # 5 % of |K| at 100 Hz
-    (TABLE_1, 5e-6, "kg·m²"),  # 5e-6 kg·m²: ω²J is about 5 % of Table 1's |K| at 100 Hz
-])
-def test_the_diagnosis_shows_a_found_mass_in_its_modes_unit(design, mass, unit):
+@pytest.mark.parametrize("design, unit", [(PAPER_B, "kg"), (TABLE_1, "kg·m²")])
+def test_the_diagnosis_words_a_mass_in_its_modes_unit(design, unit):
+    """Data without a fixture, a design that carries an apparent mass: the data do not see a
+    small mass, and the diagnosis says up to what mass, in kg on the axial rig and in kg·m² on
+    the torsion rig (it used to print kg/kg·m² for both)."""
     amplitudes = (1e-5, 4e-5, 1e-4, 1.7e-4, 3.5e-4) if design.mode == "axial" else tuple(np.geomspace(1e-4, 1e-1, 5))
-    data = synthetic_stiffness(design.replace(effects={"inertia": {"mass": mass}}), np.linspace(1.0, 100.0, 30),
-                               amplitudes, noise=0.005, seed=7)
-    result = diagnose(design, data, held_out=False)
-    assert result.added == ["inertia"]
-    step = result.steps[0]
-    assert step.units == {"mass": unit}
+    data = synthetic_stiffness(design, np.linspace(1.0, 100.0, 30), amplitudes, noise=0.005, seed=7)
+    result = diagnose(design.replace(effects={"inertia": {"mass": 1e-3}}), data, held_out=False)
+    low, high = result.final.fit.intervals["inertia.mass"]
+    assert low is None
     text = summary(result)
-    assert f"mass = {step.parameters['mass']:.4g} ± {step.standard_errors['mass']:.2g} {unit};" in text
+    assert f"inertia.mass is not determined by these data: any value up to {high:.3g} {unit} fits" in text
     assert "kg/" not in text

@@ -54,16 +54,6 @@ class Step:
     mode: str | None = None  # data of several modes: the rig a rig effect (a mass) was found on
     by_mode: dict = field(default_factory=dict)  # data of several modes: each mode's evidence
     undetermined: tuple[str, ...] = ()  # of ``parameters``, those the final model's profile leaves open
-    units: dict[str, str] = field(default_factory=dict)  # of ``parameters``, in the mode they act in
-
-    def values_words(self) -> str:
-        """``mass = 0.5247 ± 0.018 kg``: each parameter with its standard error and unit."""
-        def one(k, v):
-            e = self.standard_errors.get(k, math.nan)
-            unit = self.units.get(k, "–")
-            return (f"{k} = {v:.4g}" + (f" ± {e:.2g}" if math.isfinite(e) else "")
-                    + ("" if unit == "–" else f" {unit}"))
-        return ", ".join(one(k, v) for k, v in self.parameters.items()) or "no parameters"
 
     @property
     def supported_by(self) -> list[str]:
@@ -195,7 +185,8 @@ def summary(diagnosis: Diagnosis) -> str:
         lines[0] += f" (noise alone gives about {diagnosis.noise_gap:.4g})"
     lines.append(f"  where it disagrees: {diagnosis.where_baseline}")
     for n, s in enumerate(diagnosis.steps, 1):
-        params = s.values_words()
+        params = ", ".join(f"{k} = {v:.4g}" + (f" ± {s.standard_errors[k]:.2g}" if math.isfinite(s.standard_errors.get(k, math.nan)) else "")
+                           for k, v in s.parameters.items()) or "no parameters"
         support = s.support_words()
         lines.append(f"step {n}: add {s.effect} ({s.title}){' ' + support if s.mode else ''}: {params}; "
                      f"BIC drop {s.bic_drop:.1f}; gap {s.gap_before:.4g} -> {s.gap_after:.4g}"

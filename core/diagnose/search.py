@@ -11,7 +11,7 @@ import numpy as np
 
 from ..data import MAX_FIT_POINTS, MeasuredStiffness
 from ..design import Design
-from ..effects import effect_of, parameter_unit, split_id
+from ..effects import effect_of, split_id
 from ..fit import (
     fit_global,
     gap,
@@ -261,10 +261,9 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
                   for p, n in names.items()}
         rig_mode = (split_id(a.effect)[1] or design.mode) if modes and effect.rig else None
         support = _support(a.before, a.after, data, on(a.before), on(a.after)) if modes else {}
-        units = {p: parameter_unit(n, design.mode) for p, n in names.items()}  # the mode's (kg or kg·m²)
         steps.append(Step(effect.id, effect.title, where(a.before), a.before.bic - a.after.bic,
                           explains(a.before, a.after, noise)[1], params, on(a.before).gap, on(a.after).gap, a.drops,
-                          a.evidence, errors, rig_mode, support, vague, units))
+                          a.evidence, errors, rig_mode, support, vague))
     held = {}
     if held_out:
         say(0.85, "checking on held-out data")
