@@ -29,6 +29,9 @@ MAX_FIT_SAMPLES = 2000
 # measured frequencies: from creep-like tests to the acoustic range; beyond, the time base or
 # the units are wrong
 MEASURED_FREQUENCY_HZ = (1e-4, 1e5)
+# measured |K| (N/m or N·m/rad) and a loop's force per displacement: from a thread to a bridge
+# bearing; beyond, the units are wrong (and a fit's relative misfit loses every digit)
+STIFFNESS_RANGE = (1e-6, 1e15)
 # a loop's drive must be a steady sine: the RMS departure from the best sine, relative to its
 # amplitude, is at most this
 LOOP_SINE_DEPARTURE = 0.1
@@ -217,6 +220,16 @@ class MeasuredLoop:
         cols = {"time_s": self.time_s, "displacement": self.displacement, "force": self.force}
         return _written(csv_text(cols, FILE_NUMBER_FORMAT), path)
 
+    def check_force(self) -> None:
+        """The force's scale (checked after the amplitude's, whose rule names a wrong unit more
+        plainly): its peak over the displacement's within :data:`STIFFNESS_RANGE`."""
+        force = self.force - np.mean(self.force)
+        ratio = float(np.max(np.abs(force))) / self.harmonic()[1]
+        lo, hi = STIFFNESS_RANGE
+        if not lo <= ratio <= hi:
+            raise DataError(f"loop file: the peak force per peak displacement ({ratio:.3g} N/m or N·m/rad) "
+                            f"must be within {lo:g}–{hi:g}; are the units of force and displacement right?")
+
     def harmonic(self):
         """Frequency (Hz), peak amplitude and the phase θ(t) of the drive x ≈ x̂ sin θ, from a
         least-squares sine fit (frequency refined around the spectral peak); computed once."""
@@ -387,9 +400,15 @@ def parse_stiffness(text: str | bytes) -> MeasuredStiffness:
     # any finite complex stiffness is a possible measurement: Im K < 0 (a negative loss factor)
     # is a blocked transfer stiffness above a wave resonance, Re K < 0 a mass-dominated one
     with np.errstate(over="ignore"):
-        bad = np.flatnonzero(~np.isfinite(np.abs(k)) | (np.abs(k) == 0))
+        size = np.abs(k)
+    bad = np.flatnonzero(~np.isfinite(size) | (size == 0))
     if bad.size:
         raise DataError(f"line {bad[0] + 2}: the stiffness is zero or too large for a number")
+    lo, hi = STIFFNESS_RANGE
+    bad = np.flatnonzero((size < lo) | (size > hi))
+    if bad.size:
+        raise DataError(f"line {bad[0] + 2}: the stiffness magnitude |K| = {size[bad[0]]:.3g} must be within "
+                        f"{lo:g}–{hi:g} N/m or N·m/rad; are the units right?")
     return MeasuredStiffness(v["frequency_hz"], v["amplitude"], k, None, mode)
 
 
@@ -439,6 +458,8 @@ def parse_loop(text: str | bytes) -> MeasuredLoop:
         raise DataError(f"line {bad[0] + 3}: time_s must increase (after {v['time_s'][bad[0]]:g})")
     if np.ptp(v["displacement"]) == 0:
         raise DataError("loop file: the displacement never moves")
+    if np.ptp(v["force"]) == 0:
+        raise DataError("loop file: the force never moves")
     loop = MeasuredLoop(v["time_s"], v["displacement"], v["force"])
     _check_harmonic(loop)
     return loop
@@ -458,7 +479,8 @@ def _check_harmonic(loop: MeasuredLoop) -> None:
         departure = float(np.sqrt(np.mean((x - np.mean(x) - np.sin(phase)) ** 2)))
     lo, hi = MEASURED_FREQUENCY_HZ
     if not (math.isfinite(f) and lo <= f <= hi):
-        raise DataError(f"loop file: its frequency ({f:.3g} Hz from a time step of {dt:.3g} s) must be within "
+        found = f"{f:.3g} Hz" if math.isfinite(f) and f > 0 else "none found"
+        raise DataError(f"loop file: its frequency ({found}, from a time step of {dt:.3g} s) must be within "
                         f"{lo:g}–{hi:g} Hz; is time_s in seconds?")
     if f * (span + dt) < 0.99:
         raise DataError(f"loop file: it holds {f * (span + dt):.2f} of a period at {f:.3g} Hz; at least one "
@@ -466,3 +488,4 @@ def _check_harmonic(loop: MeasuredLoop) -> None:
     if not departure <= LOOP_SINE_DEPARTURE:
         raise DataError(f"loop file: the displacement is not a steady sine (its RMS departure from the best "
                         f"sine is {departure:.0%} of the amplitude; at most {LOOP_SINE_DEPARTURE:.0%})")
+

@@ -415,6 +415,7 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
         check_data_amplitudes(design, data)  # the measured amplitudes, for this bushing
     if loop is not None:
         check_measured_amplitude(design, loop.harmonic()[1], "the loop's amplitude")
+        loop.check_force()  # after the amplitude: a displacement in wrong units is named as such
     n = (0 if data is None else 2 * len(data)) + (0 if loop is None else loop.force.size)
     if n <= len(free):
         raise ValueError(f"{n // 2} points cannot determine {len(free)} parameters")
