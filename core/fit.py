@@ -389,7 +389,9 @@ def _result(problem: _Problem, sol, method: str, starts: int, design: Design, in
     loop_rms = None
     if loop is not None:
         f = sum(loop_force(fitted, problem.loop_f, problem.loop_amp, loop.harmonic()[2]))
-        loop_rms = float(np.sqrt(np.mean((f - (loop.force - np.mean(loop.force))) ** 2)) / problem.loop_scale)
+        measured = loop.force - np.mean(loop.force)
+        # docs/files.md: relative to the loop's peak force (the fit weighs it by its RMS instead)
+        loop_rms = float(np.sqrt(np.mean((f - measured) ** 2)) / np.max(np.abs(measured)))
     n = 0 if data is None else data.measured_points
     return FitResult(fitted, errors, corr, g, float(sol.cost), n, method, starts, loop_rms,
                      intervals=intervals or {}, warnings=tuple(warnings), gap_by_mode=by_mode)
