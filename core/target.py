@@ -5,8 +5,9 @@ The search works in logarithms: the inner radius a, the rubber's thickness t = b
 always) and the length L, and the free material parameters. Among the designs that meet every
 target it seeks those nearest the starting design (the sum of squared log changes), by SLSQP
 (SciPy) from the start and from a seeded Latin hypercube over the limits. If none meets the
-targets, the design that misses them least (least squares on the misses, in logarithms) is
-reported with the targets it misses and the limits that bind there.
+targets, the design that misses them least within the limits (least squares on the misses, in
+logarithms, with the limits held) is reported with the targets it misses and the limits that
+bind there.
 
 The search is bounded by counts, never by the clock (a loaded machine finds what a fast one
 does): :data:`STARTS` starting points, at most :data:`MAX_ITERATIONS` SLSQP iterations from
@@ -46,10 +47,11 @@ FEASIBLE = 1e-6  # a constraint counts as met down to this (in logarithms)
 # SLSQP iterations from one start: feasible searches converge in at most 15, an impossible one
 # gives up (status 8) within 75
 MAX_ITERATIONS = 60
+INSIDE = 1e-7  # the closest miss keeps this log-margin inside the limits
+CLOSEST_NFEV = 100  # least-squares iterations from each of the closest miss's starts (need < 35)
 # evaluations of one target at one design (a few stiffnesses, about 0.1 ms): no new start once
 # a search has spent these; the start under way adds at most MAX_ITERATIONS (n + 2) per target
 TARGET_EVALUATIONS = 20_000
-CLOSEST_NFEV = 100  # least-squares iterations from each of the closest miss's starts (need < 35)
 MAX_FILE_BYTES = 1_000_000
 _FILE_KEYS = ("design", "targets", "tolerance", "limits", "free_material", "fixed", "solutions")
 
@@ -319,8 +321,13 @@ def _found_words(problem: Problem, solutions: list[Solution]) -> str:
 
 
 def _closest(problem: Problem, ev: _Evaluator, points) -> Solution:
-    """The design that misses the targets least: least squares on the negative margins."""
+    """The design that misses the targets least within the limits (b's range, each drive's
+    strain). First least squares on every negative log-margin, limits and targets alike, which
+    keeps the limits wherever they can be kept; if a far-off target outweighed a limit in that
+    sum (a |K| of 1e300 N/m put b at 1 m against a limit of 0.04 m), the targets' misses are
+    minimised again with the limits held as constraints."""
     lo, hi = problem.bounds()
+    n_limits = 2 + sum(len(t.modes) for t in problem.targets)  # the first margins (_Evaluator._both)
     best = None
     for z0 in points[:4]:
         try:
@@ -330,7 +337,31 @@ def _closest(problem: Problem, ev: _Evaluator, points) -> Solution:
             continue
         if best is None or sol.cost < best.cost:
             best = sol
-    return _solution(problem, best.x if best is not None else np.clip(points[0], lo, hi))
+    if best is not None and np.min(ev.margins(best.x)[:n_limits]) >= 0.0:
+        return _solution(problem, best.x)
+    return _solution(problem, _closest_within_limits(ev, points, lo, hi, n_limits))
+
+
+def _closest_within_limits(ev: _Evaluator, points, lo, hi, n_limits: int) -> np.ndarray:
+    """The targets' squared misses minimised by SLSQP with the limits held (1e-7 inside them:
+    SLSQP meets a constraint to about 1e-8); the objective scaled to order one at each start,
+    which keeps the constraints tight."""
+
+    def shortfall(z):
+        miss = np.minimum(ev.margins(z)[n_limits:], 0.0)
+        return float(miss @ miss)
+
+    limits = {"type": "ineq", "fun": lambda z: ev.margins(z)[:n_limits] - INSIDE}
+    best = None
+    for z0 in points[:4]:
+        z0 = np.clip(z0, lo, hi)
+        scale = max(shortfall(z0), 1.0)
+        sol = minimize(lambda z, s=scale: shortfall(z) / s, z0, method="SLSQP", bounds=list(zip(lo, hi)),
+                       constraints=[limits], options={"maxiter": MAX_ITERATIONS, "ftol": 1e-14})
+        z = np.clip(sol.x, lo, hi)
+        if np.min(ev.margins(z)[:n_limits]) >= 0.0 and (best is None or shortfall(z) < best[0]):
+            best = (shortfall(z), z)
+    return best[1] if best is not None else np.clip(points[0], lo, hi)
 
 
 def _why(problem: Problem, closest: Solution) -> str:
