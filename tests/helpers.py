@@ -3,34 +3,8 @@
 import asyncio
 import contextlib
 import queue
-import socket
 import threading
-import time
 import urllib.request
-
-
-def free_port() -> int:
-    """A port that was free a moment ago. Racy (another process may take it before the caller
-    binds it): for tests/test_cli.py's `bushing serve --port`; new tests bind port 0 instead
-    (:func:`served`)."""
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def wait_for(url: str, timeout: float = 30.0) -> bytes:
-    """The body of ``url`` once it answers 200, for a server that may not listen yet (another
-    process starting); fails after ``timeout`` seconds."""
-    deadline = time.time() + timeout
-    while True:
-        try:
-            with urllib.request.urlopen(url, timeout=5) as r:
-                if r.status == 200:
-                    return r.read()
-        except OSError:
-            if time.time() > deadline:
-                raise
-        time.sleep(0.2)
 
 
 def fetch(url: str, timeout: float = 60.0) -> bytes:
