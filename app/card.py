@@ -13,6 +13,7 @@ from core.shape import long_shape_factor
 from . import plots, units
 from .curves import card_bands, card_sweeps, padded
 from .explorer import BAND_PARAMETERS
+from .inputs import FloatInput
 from .live import LivePlot
 from .state import ExplorerState
 from .views import PlotView
@@ -37,8 +38,8 @@ class CardView(PlotView):
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
         self.inputs = pn.Row(
-            pn.widgets.FloatInput.from_param(self.param.displacement_mm, start=1e-6, end=100.0, step=0.01),
-            pn.widgets.FloatInput.from_param(self.param.angle_rad, start=1e-7, end=1.0, step=0.001),
+            FloatInput.from_param(self.param.displacement_mm, start=1e-6, end=100.0, step=0.01),
+            FloatInput.from_param(self.param.angle_rad, start=1e-7, end=1.0, step=0.001),
             sizing_mode="stretch_width")
         self.table = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.dims = plots.card_dimensions()

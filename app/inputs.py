@@ -22,6 +22,12 @@ class FloatInput(pn.widgets.FloatInput):
     _priority_changes: typing.ClassVar[list[str]] = ["value"]
 
 
+class IntInput(pn.widgets.IntInput):
+    """Panel's IntInput without the 50 ms debounce on its value (see :class:`FloatInput`)."""
+
+    _priority_changes: typing.ClassVar[list[str]] = ["value"]
+
+
 class FloatSlider(pn.widgets.FloatSlider):
     """Panel's FloatSlider without the 50 ms debounce on its value (see :class:`FloatInput`)."""
 

@@ -17,6 +17,7 @@ from core.target import Found, TargetError, problem_from_dict, solve
 from core.tolerance import ToleranceError
 
 from . import plots, units
+from .inputs import FloatInput, IntInput
 from .live import LivePlot
 from .state import ExplorerState
 from .views import PlotView
@@ -71,7 +72,7 @@ class WhatIfView(PlotView):
         self._showing = False
         super().__init__(state, **params)
         self.tolerance_inputs = {
-            n: pn.widgets.FloatInput(label=f"{NAMES[n]} ± %", value=self._shown_tolerances().get(n, 0.0), start=0.0,
+            n: FloatInput(label=f"{NAMES[n]} ± %", value=self._shown_tolerances().get(n, 0.0), start=0.0,
                                      end=89.0, step=0.5, width=170)
             for n in SENSITIVITY_PARAMETERS}
         for name, widget in self.tolerance_inputs.items():
@@ -80,8 +81,8 @@ class WhatIfView(PlotView):
         self.band_controls = pn.Row(
             pn.widgets.Checkbox.from_param(s.band_on, margin=(28, 10), width=330, css_classes=["band-switch"]),
             pn.widgets.Select.from_param(s.band_distribution, width=120),
-            pn.widgets.IntInput.from_param(s.band_samples, width=100),
-            pn.widgets.IntInput.from_param(s.band_seed, width=100),
+            IntInput.from_param(s.band_samples, width=100),
+            IntInput.from_param(s.band_seed, width=100),
             pn.widgets.Checkbox.from_param(s.band_from_fit, margin=(28, 10)),
             sizing_mode="stretch_width")
         self.band_status = pn.pane.HTML("", sizing_mode="stretch_width")
@@ -274,7 +275,7 @@ class WhatIfView(PlotView):
         self.state.adopt(design.replace(name=f"{self.state.design.name or 'Design'} (from targets)"))
 
     def __panel__(self):
-        w = pn.widgets.FloatInput.from_param
+        w = FloatInput.from_param
         tol_grid = pn.GridBox(*self.tolerance_inputs.values(), ncols=4, sizing_mode="stretch_width")
         form = pn.Column(
             pn.Row(w(self.param.target_magnitude, width=150), w(self.param.target_tolerance_pct, width=120),

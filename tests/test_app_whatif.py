@@ -147,3 +147,19 @@ def test_a_band_that_leaves_the_table_keeps_the_card_and_says_why(app):
     assert "At 10 Hz" in app.card.table.object and "not available" not in app.card.table.object
     assert "finite-length shape factors cover" in app.state.band_message
     assert all("band" not in (e.label or "") for e in app.card.frame("translation"))
+
+
+def test_no_number_field_of_any_tab_waits_before_it_sends_its_value(app):
+    """Panel's number widgets send a typed value 50 ms late, while a button's click is handled at
+    once: a click right after typing (the design form's "Find designs") worked on the old value.
+    Every typed or dragged number in the app sends its value at once (app.inputs)."""
+    import panel as pn
+
+    for name in ("slices", "teaching", "card", "measured", "diagnosis", "whatif"):
+        app.view(name)
+    numbers = (pn.widgets.FloatInput, pn.widgets.IntInput, pn.widgets.FloatSlider, pn.widgets.IntSlider,
+               pn.widgets.EditableFloatSlider)
+    found = [w for w in app.__panel__().select(pn.widgets.Widget) if isinstance(w, numbers)]
+    assert len(found) > 20  # the design's fields, the tolerances, the targets, the card's drive …
+    late = [f"{type(w).__name__} {w.name!r}" for w in found if "value" not in type(w)._priority_changes]
+    assert not late, late
