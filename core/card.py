@@ -14,8 +14,7 @@ import numpy as np
 
 from .bushing import factors, stiffness_points
 from .data import loss_factor
-from .design import Design
-from .shape import TRANSLATIONS
+from .design import TRANSLATIONS, Design
 
 CARD_MODES = ("axial", "radial", "torsion", "conical")
 

@@ -29,6 +29,8 @@ from pathlib import Path
 from typing import Any
 
 MODES = ("axial", "torsion", "radial", "conical")
+TRANSLATIONS = ("axial", "radial")  # amplitude in m, stiffness in N/m, a rig's mass in kg
+ROTATIONS = ("torsion", "conical")  # amplitude in rad, stiffness in N·m/rad, a mass in kg·m²
 # shape factors: closed forms of long bushings (the thesis'), or finite-length FE (core/shape.py)
 SHAPES = ("long", "finite")
 DEFAULT_SHAPE = {"axial": "long", "torsion": "long", "radial": "finite", "conical": "finite"}

@@ -23,11 +23,8 @@ from typing import Any
 import numpy as np
 from scipy import special
 
-from .design import MODES, DesignError, Material, _number
+from .design import MODES, ROTATIONS, DesignError, Material, _number
 from .material import REFERENCE_FREQUENCY_HZ, fractional_modulus, friction_modulus
-
-# the modes whose drive is an angle (core.bushing.UNITS): a mass there is a moment of inertia
-ROTATIONS = ("torsion", "conical")
 
 
 @dataclass(frozen=True)

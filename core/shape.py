@@ -42,9 +42,8 @@ from pathlib import Path
 
 import numpy as np
 
-MODES = ("axial", "torsion", "radial", "conical")
-TRANSLATIONS = ("axial", "radial")  # amplitude in m, stiffness in N/m
-ROTATIONS = ("torsion", "conical")  # amplitude in rad, stiffness in N·m/rad
+from .design import MODES, TRANSLATIONS
+
 SHAPES = ("long", "finite")  # closed forms of long bushings, or the finite-length table
 DEFAULT_SHAPE = {"axial": "long", "torsion": "long", "radial": "finite", "conical": "finite"}
 TABLE_PATH = Path(__file__).with_name("shape_table.json")
