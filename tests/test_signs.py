@@ -122,7 +122,7 @@ def test_a_mass_dominated_stiffness_gives_the_fixture_mass_back(form, tmp_path, 
     data = synthetic_stiffness(truth, np.linspace(1, 100, 30), [1e-5, 1e-4, 3e-4], noise=0.003, seed=4)
     assert np.sum(data.stiffness.real < 0) >= 10
     (tmp_path / "m.csv").write_text(file_of_rows(form, data))
-    (tmp_path / "d.json").write_text(json.dumps(design_dict(PAPER_B)))
+    (tmp_path / "d.json").write_text(json.dumps(PAPER_B.to_dict()))
     code, out = run(["diagnose", str(tmp_path / "m.csv"), "--design", str(tmp_path / "d.json"),
                      "--json", str(tmp_path / "r.json")], capsys)
     assert code == 0, out.err
@@ -136,10 +136,6 @@ def file_of_rows(form: str, data) -> str:
     return (f"frequency_hz,amplitude,{HEADERS[form]}\n"
             + "".join(f"{float(f)!r},{float(a)!r},{row_of(form, complex(k))}\n"
                       for f, a, k in zip(data.frequency_hz, data.amplitude, data.stiffness)))
-
-
-def design_dict(design) -> dict:
-    return design.to_dict()
 
 
 def overlays_of(layout):
@@ -169,7 +165,7 @@ def test_plots_draw_the_loss_factor_with_its_sign_and_log_axes_only_over_positiv
 
 
 def test_exports_carry_the_sign_of_a_mass_dominated_stiffness(tmp_path, capsys):
-    massive = design_dict(PAPER_B)
+    massive = PAPER_B.to_dict()
     massive["effects"] = {"inertia": {"mass": 20.0}}
     (tmp_path / "d.json").write_text(json.dumps(massive))
     code, out = run(["export", str(tmp_path / "d.json"), "--format", "table", "--freq", "1", "100", "3",
