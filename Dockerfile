@@ -13,6 +13,7 @@ WORKDIR /opt/bushing
 COPY pyproject.toml README.md ./
 COPY core ./core
 COPY app ./app
+COPY cli ./cli
 RUN python3 -m venv /opt/venv && /opt/venv/bin/pip install . \
     && useradd --create-home --uid 10001 bushing
 

@@ -23,7 +23,7 @@ from core.bushing import (
     strain_factor,
 )
 from core.data import MeasuredLoop, MeasuredStiffness, loss_factor, magnitude_residual_pct
-from core.fit import folded, gap
+from core.identify.fit import folded, gap
 from core.material import ConvergenceError
 
 from . import units
@@ -237,7 +237,7 @@ class ExplorerData:
 
 def operating_bands(design: Design, frequency_hz: float, amplitude: float, f, x, tolerances,
                     cache: dict | None = None) -> dict:
-    """Tolerance bands (:mod:`core.tolerance`) of the operating curves: against frequency ``f``
+    """Tolerance bands (:mod:`core.whatif.tolerance`) of the operating curves: against frequency ``f``
     at the operating ``amplitude`` and against amplitude ``x`` (display units) at the operating
     frequency. For each of ``"frequency"`` and ``"amplitude"``, (low, high) of ``magnitude``
     (display unit) and ``loss_factor`` at the tolerances' first and last percentiles; ``"point"``
@@ -247,7 +247,7 @@ def operating_bands(design: Design, frequency_hz: float, amplitude: float, f, x,
     strain computes the friction branch once, an amplitude sweep the fractional branch once) and
     the point's. ``cache`` (a dict the caller keeps) holds the last few: moving the operating
     amplitude recomputes the frequency curve's band and the point's, not the amplitude curve's."""
-    from core.tolerance import band
+    from core.whatif.tolerance import band
 
     mode = design.mode
     a_si, x_si = float(units.to_si_amplitude(amplitude, mode)), units.to_si_amplitude(x, mode)
@@ -318,7 +318,7 @@ def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq
                         reference_loop=ref_loop, measured_loop=loop_points, ranges=ranges, bands=bands)
 
 
-# ---- a diagnosis (core.diagnose.Diagnosis) ---------------------------------------------------------
+# ---- a diagnosis (core.identify.diagnose.Diagnosis) ---------------------------------------------------------
 
 
 def gap_stages(r) -> dict:
@@ -377,7 +377,7 @@ def card_sweeps(design: Design, frequency_hz: float, strains=None) -> dict:
 def card_bands(design: Design, frequency_hz: float, tolerances, strains=None) -> dict:
     """Each direction's tolerance band along :func:`card_sweeps`' curves: ``magnitude_band`` and
     ``loss_factor_band``, (low, high) at the first and last percentiles (display units)."""
-    from core.tolerance import band
+    from core.whatif.tolerance import band
 
     out = {}
     for mode, d, drive in _card_directions(design, _card_strains(strains)):
@@ -404,7 +404,7 @@ def _card_directions(design: Design, strains: np.ndarray):
 def prediction_misfit(fit, measured: MeasuredStiffness | None) -> dict | None:
     """A fit on a subset (its ``prediction``) against every measured row: per mode, the |K|
     misfit (model − measured, %) against frequency of the fitted rows and of the predicted ones."""
-    from core.fit import model_stiffness, selection
+    from core.identify.fit import model_stiffness, selection
 
     if fit is None or not fit.prediction or measured is None:
         return None

@@ -1,5 +1,5 @@
 """The "Find the missing effect" tab: a step-by-step walk through the discrepancy workflow
-(:mod:`core.diagnose`). Thin: :class:`~app.diagnosis_state.DiagnosisState` does the work."""
+(:mod:`core.identify.diagnose`). Thin: :class:`~app.diagnosis_state.DiagnosisState` does the work."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ import logging
 import numpy as np
 import panel as pn
 
-from core.diagnose import BIC_THRESHOLD
 from core.effects import EFFECTS
+from core.identify.diagnose import BIC_THRESHOLD
 from core.material import ConvergenceError
 
 from . import plots

@@ -7,8 +7,8 @@ import numpy as np
 import param
 
 from core.data import MeasuredStiffness, csv_text, parse_stiffness
-from core.diagnose import BRANCHES, Diagnosis, diagnose
 from core.effects import EFFECTS
+from core.identify.diagnose import BRANCHES, Diagnosis, diagnose
 from core.synthetic import MYSTERIES, Mystery
 
 from . import curves

@@ -12,7 +12,7 @@ import panel as pn
 import param
 
 from core import PAPER_B
-from core.fit import PARAMETERS
+from core.identify.fit import PARAMETERS
 from core.synthetic import paper_b_example
 
 from . import curves, plots

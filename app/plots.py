@@ -208,7 +208,7 @@ def band_label(percentiles) -> str:
 
 
 def sensitivity_bars(bars: hv.Bars, title: str, color: str, png: str) -> hv.Bars:
-    """Sensitivities as a bar chart, largest first (:mod:`core.sensitivity`)."""
+    """Sensitivities as a bar chart, largest first (:mod:`core.whatif.sensitivity`)."""
     return bars.opts(title=title, color=color, responsive=True, height=260, framewise=True, tools=["hover"],
                      hooks=[png_name(png)], fontsize={"title": "13px"}, xrotation=0, show_legend=False)
 
@@ -471,7 +471,7 @@ def misfit_map(m: dict, column: str, title: str, dims: dict, limit: float, png: 
 
 
 def diagnosis_overlays(diagnosis) -> dict:
-    """The plots of a :class:`core.diagnose.Diagnosis`: ``"gap"`` (one plot: the gap after each
+    """The plots of a :class:`core.identify.diagnose.Diagnosis`: ``"gap"`` (one plot: the gap after each
     step), ``"curves"`` (|K| and the loss factor: data, baseline, final model) and ``"maps"``
     (the misfit before, then after: |K| and the loss factor each, on one colour scale per
     quantity); ``"groups"`` the curves' amplitude groups (:func:`app.curves.curve_groups`)."""
@@ -494,7 +494,7 @@ def diagnosis_overlays(diagnosis) -> dict:
 
 
 def diagnosis_plots(diagnosis, *, width: int | None = 560) -> hv.Layout:
-    """A :class:`core.diagnose.Diagnosis`: the gap after each step, the data against the
+    """A :class:`core.identify.diagnose.Diagnosis`: the gap after each step, the data against the
     baseline and the final model, and the misfit maps before and after."""
     overlays = diagnosis_overlays(diagnosis)
     return sized(hv.Layout(overlays["gap"] + overlays["curves"] + overlays["maps"]).cols(2), width)

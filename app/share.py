@@ -10,7 +10,7 @@ import panel as pn
 
 from core.data import csv_text
 from core.design import dumps_design
-from core.export import export
+from core.io.export import export
 
 from .state import ExplorerState
 from .units import to_si_amplitude

@@ -25,9 +25,16 @@ from core.data import (
     parse_stiffness,
 )
 from core.design import SIZE_RANGE, as_dict
-from core.fit import PARAMETERS as MATERIAL_PARAMETERS
-from core.fit import FitResult, fit_global, fit_two_step, predicted, selection
-from core.tolerance import SAMPLES, FitCovariance, ToleranceError, Tolerances, band, band_columns
+from core.identify.fit import PARAMETERS as MATERIAL_PARAMETERS
+from core.identify.fit import FitResult, fit_global, fit_two_step, predicted, selection
+from core.whatif.tolerance import (
+    SAMPLES,
+    FitCovariance,
+    ToleranceError,
+    Tolerances,
+    band,
+    band_columns,
+)
 
 from . import curves, units
 from .units import FREQUENCY_BOUNDS
@@ -486,7 +493,7 @@ class ExplorerState(param.Parameterized):
         self.tolerance_text = ",".join(f"{TOLERANCE_KEYS[n]}:{v:g}" for n, v in values.items() if v)
 
     def tolerances(self) -> Tolerances | None:
-        """The tolerances the bands are drawn with (:class:`core.tolerance.Tolerances`), None
+        """The tolerances the bands are drawn with (:class:`core.whatif.tolerance.Tolerances`), None
         when bands are off or nothing varies. Raises ToleranceError with the reason."""
         if not self.band_on:
             return None

@@ -12,9 +12,9 @@ import holoviews as hv
 import panel as pn
 import param
 
-from core.sensitivity import SENSITIVITY_PARAMETERS, SYMBOLS, elasticities, ranked, sentence
-from core.target import Found, TargetError, problem_from_dict, solve
-from core.tolerance import ToleranceError
+from core.whatif.sensitivity import SENSITIVITY_PARAMETERS, SYMBOLS, elasticities, ranked, sentence
+from core.whatif.target import Found, TargetError, problem_from_dict, solve
+from core.whatif.tolerance import ToleranceError
 
 from . import plots, units
 from .inputs import FloatInput, IntInput
@@ -65,7 +65,7 @@ class WhatIfView(PlotView):
     mu_min_mpa = param.Number(default=None, allow_None=True, bounds=(0, None), label="µ from (MPa)")
     mu_max_mpa = param.Number(default=None, allow_None=True, bounds=(0, None), label="µ to (MPa)")
     running = param.Boolean(default=False)
-    found = param.Parameter(default=None, doc="The last search's core.target.Found.")
+    found = param.Parameter(default=None, doc="The last search's core.whatif.target.Found.")
     message = param.String(default="")
 
     def __init__(self, state: ExplorerState, **params):

@@ -116,7 +116,7 @@ def free_port():
 def start_server(port, command=None, probe="/liveness"):
     """Start the explorer (or ``command``, another server) and wait until ``probe`` answers."""
     proc = subprocess.Popen(
-        command or [sys.executable, "-m", "app.cli", "serve", "--port", str(port)],
+        command or [sys.executable, "-m", "cli.main", "serve", "--port", str(port)],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )
     deadline = time.time() + 60

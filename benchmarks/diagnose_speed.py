@@ -14,7 +14,7 @@ import numpy as np
 
 from core import PAPER_B, TABLE_1
 from core.data import MeasuredStiffness, combined
-from core.diagnose import diagnose
+from core.identify.diagnose import diagnose
 from core.synthetic import synthetic_stiffness
 
 TARGET_S = 5.0

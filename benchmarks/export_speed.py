@@ -10,7 +10,7 @@ import time
 import numpy as np
 
 from core import PAPER_B
-from core.export import export
+from core.io.export import export
 
 FREQS = np.geomspace(1, 100, 30)
 AMPS = np.geomspace(1e-6, 1e-3, 10)

@@ -13,7 +13,7 @@ import numpy as np
 
 from core import PAPER_B, TABLE_1
 from core.data import MeasuredStiffness, combined
-from core.fit import fit_global, fit_two_step
+from core.identify.fit import fit_global, fit_two_step
 from core.synthetic import synthetic_loop, synthetic_stiffness
 
 

@@ -44,7 +44,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[150, 1500, 15000, 100000])
     args = parser.parse_args()
-    bushing = [sys.executable, "-m", "core.cli"]
+    bushing = [sys.executable, "-m", "cli.commands"]
     with tempfile.TemporaryDirectory() as tmp:
         design = Path(tmp) / "guess.json"
         write_design(PAPER_B.replace(shear_modulus=1.5e6, fractional_coefficient=1e6, fractional_order=0.4,

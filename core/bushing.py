@@ -22,10 +22,10 @@ from typing import Literal
 import numpy as np
 
 from . import material as mat
-from . import shape as shapes
 from .data import ComplexStiffness, loss_factor
-from .design import DEFAULT_SHAPE, Design, Geometry
+from .design import Design
 from .effects import EFFECTS, branch_moduli, extended_modulus, inertia_correction, wave_stiffness
+from .shape import shape_factor, strain_factor
 from .slices import continuum_node_count, continuum_nodes, slice_nodes, solve_series
 
 UNITS = {
@@ -37,30 +37,6 @@ UNITS = {
 
 Route = Literal["analytic", "time-domain"]
 ROUTES = ("analytic", "time-domain")
-
-
-def shape_factor(geometry: Geometry, mode: str, shape: str | None = None) -> float:
-    """S with K = S·µ_eq (m for axial and radial, m³/rad for torsion and conical): the closed
-    forms of :mod:`core.shape` for ``shape="long"`` (torsion S = 4π a² b² L / (b² − a²),
-    eq 17; axial S = 2π L / ln(b/a), eq 18; radial, plane strain), the finite-length FE table
-    for ``"finite"``; ``None``: the mode's default (long for axial and torsion, finite for
-    radial and conical)."""
-    a, b, L = geometry.inner_radius, geometry.outer_radius, geometry.length
-    if (shape or DEFAULT_SHAPE[mode]) == "finite":
-        return shapes.finite_shape_factor(a, b, L, mode)
-    return shapes.long_shape_factor(a, b, L, mode)
-
-
-def strain_factor(geometry: Geometry, mode: str, shape: str | None = None) -> float:
-    """c with ε_eq = c·x from the energy balance, c = √(S / (4V)), V = π(b² − a²)L: with the
-    long shape factors, torsion c = a b / (b² − a²) (eq 14) and axial
-    c = 1 / sqrt(2 (b² − a²) ln(b/a)) (eq 15). Units 1/rad or 1/m."""
-    a, b, L = geometry.inner_radius, geometry.outer_radius, geometry.length
-    if mode == "torsion" and (shape or DEFAULT_SHAPE[mode]) == "long":
-        return a * b / (b * b - a * a)  # eq 14, the same number without round-off
-    if mode == "axial" and (shape or DEFAULT_SHAPE[mode]) == "long":
-        return 1.0 / np.sqrt(2.0 * (b * b - a * a) * np.log(b / a))  # eq 15
-    return shapes.strain_factor_from_shape(shape_factor(geometry, mode, shape), a, b, L)
 
 
 def factors(design: Design) -> tuple[float, float]:

@@ -28,12 +28,10 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-MODES = ("axial", "torsion", "radial", "conical")
-TRANSLATIONS = ("axial", "radial")  # amplitude in m, stiffness in N/m, a rig's mass in kg
-ROTATIONS = ("torsion", "conical")  # amplitude in rad, stiffness in N·m/rad, a mass in kg·m²
+from .parameters import DEFAULT_SHAPE, MODES, ROTATIONS, SHAPES, TRANSLATIONS  # noqa: F401 (re-exported)
+from .shape import shape_factor, strain_factor
+
 # shape factors: closed forms of long bushings (the thesis'), or finite-length FE (core/shape.py)
-SHAPES = ("long", "finite")
-DEFAULT_SHAPE = {"axial": "long", "torsion": "long", "radial": "finite", "conical": "finite"}
 SIZE_RANGE = (1e-6, 1e3)  # m: radii and lengths from a micrometre to a kilometre, no further
 MAX_MODULUS = 1e12  # Pa: µ, m and σ_fmax at most 1 TPa (diamond's shear modulus is about half that)
 STRAIN_HALF_RANGE = (1e-9, 10.0)  # ε½: the range the fit searches
@@ -188,6 +186,26 @@ class Design:
         if (mode, shape) == (self.mode, self.shape):
             return self
         return self.replace(mode=mode, shape=shape, effects=self.portable_effects)
+
+    @property
+    def shape_factor(self) -> float:
+        """S with K = S·µ_eq (eqs 17, 18 for long bushings; m or m³/rad)."""
+        return shape_factor(self.geometry, self.mode, self.shape)
+
+    @property
+    def strain_factor(self) -> float:
+        """c with ε_eq = c·x̂ (eqs 14, 15 for long bushings; 1/m or 1/rad)."""
+        return strain_factor(self.geometry, self.mode, self.shape)
+
+    def strain(self, amplitude):
+        """The equivalent strain amplitude ε_eq = c·x̂ of the drive amplitude ``amplitude`` (m or
+        rad; arrays too), eqs 14, 15."""
+        return self.strain_factor * amplitude
+
+    def drive(self, strain):
+        """The drive amplitude x̂ = ε_eq / c (m or rad) that gives the equivalent strain
+        ``strain`` (arrays too): the inverse of :meth:`strain`."""
+        return strain / self.strain_factor
 
     @property
     def shape_kind(self) -> str:

@@ -39,13 +39,15 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .design import MODES, TRANSLATIONS
+from .parameters import DEFAULT_SHAPE, MODES, TRANSLATIONS
 
-SHAPES = ("long", "finite")  # closed forms of long bushings, or the finite-length table
-DEFAULT_SHAPE = {"axial": "long", "torsion": "long", "radial": "finite", "conical": "finite"}
+if TYPE_CHECKING:  # the type only: core.design imports this module
+    from .design import Geometry
+
 TABLE_PATH = Path(__file__).with_name("shape_table.json")
 BULK_RATIO = 5000.0  # K/µ of the FE model: rubber's is 1 000–5 000
 
@@ -239,3 +241,27 @@ def finite_shape_factor(a: float, b: float, L: float, mode: str) -> float:
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     return reference_shape_factor(a, b, L, mode) * table().ratio(mode, b / a, L / (b - a))
+
+
+def shape_factor(geometry: Geometry, mode: str, shape: str | None = None) -> float:
+    """S with K = S·µ_eq (m for axial and radial, m³/rad for torsion and conical): the closed
+    forms of :mod:`core.shape` for ``shape="long"`` (torsion S = 4π a² b² L / (b² − a²),
+    eq 17; axial S = 2π L / ln(b/a), eq 18; radial, plane strain), the finite-length FE table
+    for ``"finite"``; ``None``: the mode's default (long for axial and torsion, finite for
+    radial and conical)."""
+    a, b, L = geometry.inner_radius, geometry.outer_radius, geometry.length
+    if (shape or DEFAULT_SHAPE[mode]) == "finite":
+        return finite_shape_factor(a, b, L, mode)
+    return long_shape_factor(a, b, L, mode)
+
+
+def strain_factor(geometry: Geometry, mode: str, shape: str | None = None) -> float:
+    """c with ε_eq = c·x from the energy balance, c = √(S / (4V)), V = π(b² − a²)L: with the
+    long shape factors, torsion c = a b / (b² − a²) (eq 14) and axial
+    c = 1 / sqrt(2 (b² − a²) ln(b/a)) (eq 15). Units 1/rad or 1/m."""
+    a, b, L = geometry.inner_radius, geometry.outer_radius, geometry.length
+    if mode == "torsion" and (shape or DEFAULT_SHAPE[mode]) == "long":
+        return a * b / (b * b - a * a)  # eq 14, the same number without round-off
+    if mode == "axial" and (shape or DEFAULT_SHAPE[mode]) == "long":
+        return 1.0 / np.sqrt(2.0 * (b * b - a * a) * np.log(b / a))  # eq 15
+    return strain_factor_from_shape(shape_factor(geometry, mode, shape), a, b, L)

@@ -27,6 +27,7 @@ import numpy as np
 
 from .design import Geometry
 from .material import ConvergenceError
+from .shape import shape_factor, strain_factor
 
 
 @dataclass(frozen=True)
@@ -39,8 +40,6 @@ class SeriesNodes:
 
 def slice_nodes(geometry: Geometry, mode: str, n: int) -> SeriesNodes:
     """N slices of equal radial thickness, each a small bushing (eqs 14–18)."""
-    from .bushing import shape_factor, strain_factor
-
     r = np.linspace(geometry.inner_radius, geometry.outer_radius, n + 1)
     p, q = [], []
     for r0, r1 in pairwise(r):

@@ -33,7 +33,7 @@ def run(app):
 
 def test_every_mystery_is_diagnosed_right():
     """The demo's data sets: the workflow finds what each hides (and nothing where nothing is)."""
-    from core.diagnose import diagnose
+    from core.identify.diagnose import diagnose
 
     for m in MYSTERIES:
         result = diagnose(m.design, m.data(), baseline=m.baseline, held_out=False)

@@ -9,10 +9,10 @@ import pytest
 from app.main import App
 from core import PAPER_B
 from core.bushing import stiffness_points
-from core.fit import fit_global
-from core.sensitivity import SYMBOLS, elasticities
+from core.identify.fit import fit_global
 from core.synthetic import synthetic_stiffness
-from core.tolerance import Tolerances, band
+from core.whatif.sensitivity import SYMBOLS, elasticities
+from core.whatif.tolerance import Tolerances, band
 
 
 @pytest.fixture
@@ -120,7 +120,7 @@ def test_the_design_form_says_when_targets_cannot_be_met(app):
 
 def test_tolerances_travel_in_a_link(app):
     from app.state import parse_tolerances
-    from core.tolerance import ToleranceError
+    from core.whatif.tolerance import ToleranceError
 
     assert parse_tolerances("mu:10, L:0.5") == {"shear_modulus": 10.0, "length": 0.5}
     for bad in ("mu:ten", "hardness:5", "mu:10,mu:5", "mu:95", "mu"):

@@ -10,15 +10,15 @@ import pytest
 from scipy import stats
 
 from core import PAPER_B, TABLE_1
-from core import fit as fit_module
-from core import target as target_module
 from core.data import read_stiffness
 from core.design import read_design
-from core.diagnose import diagnose, summary
 from core.effects import parameter_unit
-from core.fit import fit_global
+from core.identify import fit as fit_module
+from core.identify.diagnose import diagnose, summary
+from core.identify.fit import fit_global
+from core.identify.uncertainty import SIDE_EVALUATIONS, minimise, profile
 from core.synthetic import synthetic_stiffness
-from core.uncertainty import SIDE_EVALUATIONS, minimise, profile
+from core.whatif import target as target_module
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

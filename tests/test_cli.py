@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from app.cli import main  # the `bushing` entry point
+from cli.main import main  # the `bushing` entry point
 from core import PAPER_B, TABLE_1, loop, stiffness, write_design
 from tests.helpers import fetch
 
@@ -176,7 +176,7 @@ def test_installed_entry_point_runs_without_traceback(designs, tmp_path):
         capture_output=True, text=True, check=False,
     )
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "Traceback" not in bad.stderr
-    # the script is the whole command line (app.cli), not the core's alone: it knows `serve`
+    # the script is the whole command line (cli.main), not the core's alone: it knows `serve`
     helped = subprocess.run([*bushing, "--help"], capture_output=True, text=True, check=False)
     assert helped.returncode == 0 and "serve" in helped.stdout
 
@@ -185,7 +185,7 @@ def test_serve_prints_its_url_and_answers():
     """`bushing serve --port 0`: the OS picks a free port (no "find one, then bind it" race) and
     the command prints the URL once its socket is bound, so one request is answered without
     polling (it waits in the listen backlog)."""
-    proc = subprocess.Popen([sys.executable, "-m", "app.cli", "serve", "--port", "0"],
+    proc = subprocess.Popen([sys.executable, "-m", "cli.main", "serve", "--port", "0"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         line = proc.stdout.readline()

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from cli.commands import main
 from core import PAPER_B, write_design
-from core.cli import main
 from core.data import (
     MAX_BYTES,
     DataError,

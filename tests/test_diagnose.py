@@ -9,12 +9,12 @@ import math
 import numpy as np
 import pytest
 
+from cli.commands import main
 from core.bushing import shape_factor, stiffness_points
-from core.cli import main
 from core.data import MeasuredStiffness, read_stiffness
 from core.design import PAPER_B, TABLE_1, design_from_dict, write_design
-from core.diagnose import BRANCHES, OFF, describe, diagnose, noise_variance, summary
 from core.effects import EFFECTS
+from core.identify.diagnose import BRANCHES, OFF, describe, diagnose, noise_variance, summary
 from core.synthetic import synthetic_stiffness
 
 NOISE = 0.005

@@ -4,7 +4,7 @@ import re
 import subprocess
 from pathlib import Path
 
-from app.cli import build_parser
+from cli.main import build_parser
 from core.effects import EFFECTS
 
 ROOT = Path(__file__).resolve().parents[1]

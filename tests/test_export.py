@@ -11,11 +11,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from app.cli import main
+from cli.main import main
 from core import PAPER_B, force_history, write_design
 from core.bushing import stiffness_points, strain_factor
 from core.card import CARD_MODES, card_design
-from core.export import direction_grid, export
+from core.io.export import direction_grid, export
 
 FREQS = np.linspace(1.0, 100.0, 5)
 AMPS = [1e-5, 1e-4]

@@ -8,7 +8,7 @@ from numpy.testing import assert_allclose
 from core import PAPER_B, TABLE_1, stiffness, stiffness_points
 from core.data import MeasuredLoop
 from core.design import as_dict
-from core.fit import PARAMETERS, fit_global, fit_two_step
+from core.identify.fit import PARAMETERS, fit_global, fit_two_step
 from core.synthetic import synthetic_loop as make_loop
 from core.synthetic import synthetic_stiffness
 
@@ -89,7 +89,7 @@ def test_the_thesis_two_step_procedure_predicts_other_amplitudes():
     result = fit_two_step(start, loop, sweep)
     others = synthetic(design, np.linspace(1, 100, 20), [0.013e-3, 0.04e-3, 0.17e-3, 0.25e-3, 0.35e-3], seed=7)
     predicted = stiffness_points(result.design, others.frequency_hz, others.amplitude)
-    from core.fit import gap
+    from core.identify.fit import gap
 
     assert gap(predicted, others.stiffness) < 2 * NOISE * np.sqrt(2)
     assert result.loop_rms < 0.02 and result.method == "two-step"
@@ -140,8 +140,8 @@ def test_fit_report_is_the_design_file_plus_fit(tmp_path):
 
 
 def test_a_refitted_design_is_named_fitted_once():
-    from core.diagnose import diagnose
-    from core.fit import fitted_name
+    from core.identify.diagnose import diagnose
+    from core.identify.fit import fitted_name
     from core.synthetic import synthetic_stiffness
 
     assert fitted_name("VP") == "VP (fitted)" == fitted_name("VP (fitted)")

@@ -23,7 +23,7 @@ HANG_GUARD_S = 900  # each run takes seconds; only a hang takes a quarter of an 
 
 
 def bushing(*argv, stdout=subprocess.PIPE):
-    return subprocess.run([sys.executable, "-m", "app.cli", *map(str, argv)], stdout=stdout,
+    return subprocess.run([sys.executable, "-m", "cli.main", *map(str, argv)], stdout=stdout,
                           stderr=subprocess.PIPE, text=True, timeout=HANG_GUARD_S, check=False)
 
 

@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.cli import main
+from cli.main import main
 from tests.hostile_corpus import DESIGN, EFFECT_CASES, TOLERANCES, Accepted, Refused, corpus
 
 FOLDER = Path(tempfile.gettempdir()) / f"bushing-hostile-corpus-{os.getpid()}"

@@ -11,9 +11,9 @@ import pytest
 from core import PAPER_B, TABLE_1, strain_factor
 from core.bushing import stiffness_points
 from core.data import MeasuredStiffness
-from core.diagnose import BIC_THRESHOLD, diagnose
-from core.fit import PARAMETERS, fit_global, gap, parameter, parameter_values
-from core.sensitivity import value_of
+from core.identify.diagnose import BIC_THRESHOLD, diagnose
+from core.identify.fit import PARAMETERS, fit_global, gap, parameter, parameter_values
+from core.whatif.sensitivity import value_of
 from tests.test_material import _berg_loop_harmonic, reference_modulus
 from tests.test_shape import TABLE_ACCURACY, energy_strain_factor, fe_paper_b
 

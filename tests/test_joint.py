@@ -7,10 +7,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from app.cli import main
+from cli.main import main
 from core import PAPER_B, write_design
 from core.data import DataError, MeasuredStiffness, combined, parse_stiffness
-from core.fit import fit_global, model_stiffness, parameter_values, predicted, selection
+from core.identify.fit import fit_global, model_stiffness, parameter_values, predicted, selection
 from core.synthetic import synthetic_stiffness
 
 NOISE = 0.005
@@ -156,7 +156,7 @@ def test_a_bad_file_among_several_is_left_out_with_its_message():
 def test_a_mode_this_bushing_cannot_compute_is_named():
     """Radial rows for a bushing outside the finite-length table (b/a = 6): the message names the
     rows and the table's range, in the fit and in the diagnosis."""
-    from core.diagnose import diagnose
+    from core.identify.diagnose import diagnose
 
     wide = PAPER_B.replace(outer_radius=0.12)
     data = multi_mode(modes=("axial", "radial"), per_amplitude=5)

@@ -8,9 +8,9 @@ from core import PAPER_B
 from core.bushing import stiffness_points
 from core.data import MeasuredStiffness, combined
 from core.design import DesignError, design_from_dict
-from core.diagnose import diagnose, summary
-from core.diagnose.statistics import runs
-from core.fit import fit_global, model_stiffness
+from core.identify.diagnose import diagnose, summary
+from core.identify.diagnose.statistics import runs
+from core.identify.fit import fit_global, model_stiffness
 from core.synthetic import synthetic_stiffness
 
 NOISE = 0.005

@@ -22,7 +22,7 @@ CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 def start_backend(env: dict) -> tuple[subprocess.Popen, int]:
     """`bushing serve --port 0`: the OS picks the port, the command prints its URL once the
     socket is bound (a request then waits in the listen backlog until the server answers)."""
-    proc = subprocess.Popen([sys.executable, "-m", "app.cli", "serve", "--port", "0", "--address", "127.0.0.1"],
+    proc = subprocess.Popen([sys.executable, "-m", "cli.main", "serve", "--port", "0", "--address", "127.0.0.1"],
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env={**os.environ, **env})
     line = proc.stdout.readline()  # blocks until printed (or the process ends: "")
     found = re.search(r"http://127\.0\.0\.1:(\d+)/", line)

@@ -45,7 +45,7 @@ def test_torsion_units_and_measured_points():
 
 
 def test_slices_branches_residuals_and_diagnosis_plots():
-    from core.diagnose import diagnose
+    from core.identify.diagnose import diagnose
 
     sl = plots.slices_plots(PAPER_B, 10.0, 0.1)
     x, k3 = xy(sl[0], "3 slices")

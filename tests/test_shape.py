@@ -161,7 +161,7 @@ def test_bushing_card_on_the_command_line(tmp_path, capsys):
     import csv
     import io
 
-    from app.cli import main
+    from cli.main import main
     from core import write_design
     from core.bushing import stiffness_points
     from core.card import card_design, ratios
@@ -193,7 +193,7 @@ def test_bushing_card_on_the_command_line(tmp_path, capsys):
 def test_a_radial_measurement_identifies_the_material():
     """Synthetic radial data (five displacements, 0.5 % noise): the fit in radial mode recovers
     the five parameters within its intervals; the same material predicts the axial card."""
-    from core.fit import fit_global, parameter_values
+    from core.identify.fit import fit_global, parameter_values
     from core.synthetic import synthetic_stiffness
 
     truth = PAPER_B.replace(mode="radial")

@@ -11,8 +11,8 @@ import pytest
 from numpy.testing import assert_allclose
 
 from app import plots
+from cli.commands import main
 from core import PAPER_B
-from core.cli import main
 from core.data import DataError, parse_stiffness
 from core.design import design_from_dict
 from core.synthetic import synthetic_stiffness

@@ -14,9 +14,9 @@ from scipy import stats
 from core import PAPER_B
 from core.data import read_stiffness
 from core.design import read_design
-from core.fit import fit_global, parameter_values
+from core.identify.fit import fit_global, parameter_values
+from core.identify.uncertainty import profile
 from core.synthetic import synthetic_stiffness
-from core.uncertainty import profile
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
@@ -109,7 +109,7 @@ def test_the_diagnosis_inherits_the_profile():
     """The diagnosis of the single-amplitude sweep adds friction, then says what the data cannot
     fix: its report carries the final model's intervals (holding the truth) and warnings, and a
     step's standard error of an undetermined parameter is null."""
-    from core.diagnose import diagnose, summary
+    from core.identify.diagnose import diagnose, summary
 
     design = read_design(EXAMPLES / "paper_b_guess.json")
     truth = parameter_values(read_design(EXAMPLES / "paper_b_true.json"))

@@ -9,15 +9,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from app.cli import main
+from cli.main import main
 from core import PAPER_B, TABLE_1, write_design
 from core.bushing import stiffness_points
 from core.data import loss_factor
-from core.fit import PARAMETERS, fit_global, parameter
-from core.sensitivity import elasticities, log_derivatives, sentence, value_of
+from core.identify.fit import PARAMETERS, fit_global, parameter
 from core.synthetic import synthetic_stiffness
-from core.target import TargetError, problem_from_dict, solve
-from core.tolerance import FitCovariance, ToleranceError, Tolerances, band, loads_tolerances
+from core.whatif.sensitivity import elasticities, log_derivatives, sentence, value_of
+from core.whatif.target import TargetError, problem_from_dict, solve
+from core.whatif.tolerance import FitCovariance, ToleranceError, Tolerances, band, loads_tolerances
 
 F = np.linspace(1, 100, 40)
 
@@ -89,7 +89,7 @@ def test_a_fits_covariance_makes_a_band_that_agrees_with_first_order():
 def jacobian_covariance(design, data, names, step=1e-5):
     """s² (JᵀJ)⁻¹ of the relative complex misfit (K − K_data)/|K_data| in the fit's coordinates
     (ln p, α itself) at ``design``, J by central differences, s² the residual variance: the
-    covariance a least-squares fit implies, by a route apart from core.fit's."""
+    covariance a least-squares fit implies, by a route apart from core.identify.fit's."""
     log = [parameter(n).log for n in names]
     theta0 = np.array([np.log(value_of(design, n)) if lg else value_of(design, n) for n, lg in zip(names, log)])
 
@@ -345,7 +345,7 @@ def test_the_vectorised_band_is_the_sample_by_sample_one(mode):
     ('[' * 40000 + ']' * 40000, "nested too deeply"),
 ])
 def test_a_targets_file_is_strict_json(text, match):
-    from core.target import loads_problem
+    from core.whatif.target import loads_problem
 
     with pytest.raises(TargetError, match=match):
         loads_problem(text)

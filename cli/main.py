@@ -1,4 +1,4 @@
-"""The ``bushing`` command line: the core's commands (:mod:`core.cli`) and ``serve``, which starts
+"""The ``bushing`` command line: the model's commands (:mod:`cli.commands`) and ``serve``, which starts
 the explorer. The arrow points one way: the app extends the core's command line, the core never
 imports the app."""
 
@@ -7,18 +7,18 @@ from __future__ import annotations
 import argparse
 import sys
 
-from core import cli as core_cli
-from core.cli import InputError
+from . import commands
+from .commands import InputError
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = core_cli.build_parser()
-    sv = core_cli.subcommands(parser).add_parser(
+    parser = commands.build_parser()
+    sv = commands.subcommands(parser).add_parser(
         "serve",
         help="start the explorer in the browser (embedded defaults, no setup)",
         description="Start the Bushing Explorer web app and print its URL.",
     )
-    sv.add_argument("--port", type=core_cli._count("--port", 0), default=5006, metavar="P", help="default 5006")
+    sv.add_argument("--port", type=commands._count("--port", 0), default=5006, metavar="P", help="default 5006")
     sv.add_argument(
         "--address", default="localhost", metavar="A",
         help="interface to listen on (default localhost; 0.0.0.0 for every interface)",
@@ -29,7 +29,7 @@ def build_parser() -> argparse.ArgumentParser:
 def _cmd_serve(args) -> None:
     if args.port > 65535:
         raise InputError(f"bushing serve: --port must be at most 65535, got {args.port}")
-    from .main import serve  # Panel and the explorer: imported only when asked for
+    from app.main import serve  # Panel and the explorer: imported only when asked for
 
     try:
         serve(port=args.port, address=args.address)
@@ -37,11 +37,11 @@ def _cmd_serve(args) -> None:
         raise InputError(f"bushing serve: cannot listen on {args.address}:{args.port}: {exc.strerror}")
 
 
-COMMANDS = {**core_cli.COMMANDS, "serve": _cmd_serve}
+COMMANDS = {**commands.COMMANDS, "serve": _cmd_serve}
 
 
 def main(argv: list[str] | None = None) -> int:
-    return core_cli.main(argv, build_parser(), COMMANDS)
+    return commands.main(argv, build_parser(), COMMANDS)
 
 
 if __name__ == "__main__":

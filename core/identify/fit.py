@@ -17,7 +17,7 @@ Standard errors come from the Jacobian at the optimum, cov = s² (JᵀJ)⁻¹ wi
 variance, carried to the natural parameters by the delta method; the correlation matrix is that
 of the fitted (log) parameters, which the monotone transforms leave unchanged to first order.
 They are only the curvature at the optimum: the 95 % intervals come from the profile of each
-parameter (:mod:`core.uncertainty`), and a parameter whose profile stays flat to the end of its
+parameter (:mod:`core.identify.uncertainty`), and a parameter whose profile stays flat to the end of its
 fitting range is reported as not determined by the data (its standard error null).
 """
 
@@ -31,11 +31,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .bushing import check_measured_amplitude, loop_force, stiffness_points
-from .data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
-from .design import Design, as_dict
-from .effects import Parameter, parameter, parameter_unit
-from .shape import OutsideTable
+from ..bushing import check_measured_amplitude, loop_force, stiffness_points
+from ..data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
+from ..design import Design, as_dict
+from ..effects import Parameter, parameter, parameter_unit
+from ..shape import OutsideTable
 from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS, linearised, minimise, profile
 
 PARAMETERS = (
@@ -407,7 +407,7 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     parameters or effect parameters as ``effect_id.name``. The search starts from the design's
     values and ``starts − 1`` seeded points around them, or, if ``initial`` is given, from those
     points (mappings of some free parameters' values, the rest the design's). With
-    ``intervals`` each parameter is profiled (:mod:`core.uncertainty`) for its interval, which
+    ``intervals`` each parameter is profiled (:mod:`core.identify.uncertainty`) for its interval, which
     may also find a better optimum than the starts did.
     Returns a :class:`FitResult`.
     """

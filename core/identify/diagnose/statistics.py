@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ..data import MeasuredStiffness
+from ...data import MeasuredStiffness
 
 BIC_THRESHOLD = 10.0
 EXPLAINED_FRACTION = 0.8  # an effect is named when it explains 80 % of the misfit above the noise

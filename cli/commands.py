@@ -18,10 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .bushing import MAX_SLICES, loop, slice_count, stiffness
-from .data import MAX_ROWS, DataError, csv_text
-from .design import DesignError, read_design, read_design_file
-from .material import ConvergenceError
+from core.bushing import MAX_SLICES, loop, slice_count, stiffness
+from core.data import MAX_ROWS, DataError, csv_text
+from core.design import DesignError, read_design, read_design_file
+from core.material import ConvergenceError
 
 NUMBER_FORMAT = "{:.12g}"
 # the largest sizes the command line computes (docs/files.md): a grid of at most a million
@@ -286,7 +286,7 @@ def _cmd_stiffness(args) -> None:
     result = stiffness(design, freqs, args.amp, slices=slices, route=args.route)
     table = result.table()
     if args.tolerance:
-        from .tolerance import band, band_columns
+        from core.whatif.tolerance import band, band_columns
 
         tolerances = _read_tolerances(args.tolerance, fit_report)
         if work * tolerances.samples > limit:
@@ -300,7 +300,7 @@ def _cmd_stiffness(args) -> None:
 def _read_tolerances(path: str, fit_report: dict | None):
     """The tolerance file, with the design file's fit report for when it asks for the fit's
     covariance."""
-    from .tolerance import MAX_FILE_BYTES, loads_tolerances
+    from core.whatif.tolerance import MAX_FILE_BYTES, loads_tolerances
 
     return loads_tolerances(_small_text(path, "tolerance", MAX_FILE_BYTES), fit_report)
 
@@ -318,7 +318,7 @@ def _small_text(path: str, what: str, limit: int) -> str:
 
 
 def _cmd_design(args) -> None:
-    from .target import MAX_FILE_BYTES, loads_problem, solve
+    from core.whatif.target import MAX_FILE_BYTES, loads_problem, solve
 
     found = solve(loads_problem(_small_text(args.targets, "targets", MAX_FILE_BYTES)))
     _write_text(found.to_json(), args.output)
@@ -362,7 +362,7 @@ MAX_MEASURED_FILES = 20
 
 def _read_measured(paths: list[str], design):
     """The measured files as one table (rows without a mode in the design's mode)."""
-    from .data import combined, read_stiffness
+    from core.data import combined, read_stiffness
 
     if len(paths) > MAX_MEASURED_FILES:
         raise InputError(f"bushing: at most {MAX_MEASURED_FILES} measured files, got {len(paths)}")
@@ -376,8 +376,8 @@ def _read_measured(paths: list[str], design):
 
 
 def _cmd_fit(args) -> None:
-    from .data import read_loop
-    from .fit import fit_global, predicted, selection
+    from core.data import read_loop
+    from core.identify.fit import fit_global, predicted, selection
 
     design = read_design(args.design)
     data = _read_measured(args.measured, design)
@@ -418,7 +418,7 @@ class Progress:
 
 
 def _cmd_diagnose(args) -> None:
-    from .diagnose import BRANCHES, diagnose, summary
+    from core.identify.diagnose import BRANCHES, diagnose, summary
 
     baseline = [b.strip() for b in args.baseline.split(",") if b.strip()]
     wrong = [b for b in baseline if b not in BRANCHES]
@@ -440,7 +440,7 @@ def _cmd_diagnose(args) -> None:
 
 
 def _cmd_card(args) -> None:
-    from .card import card
+    from core.card import card
 
     design = read_design(args.design)
     rows = card(design, args.freq, args.amp_mm * 1e-3, args.amp_rad)
@@ -449,7 +449,7 @@ def _cmd_card(args) -> None:
 
 
 def _cmd_export(args) -> None:
-    from .export import export
+    from core.io.export import export
 
     try:
         freqs = _frequencies(args)
@@ -466,7 +466,7 @@ COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop, "fit": _cmd_fit, "di
 
 def main(argv: list[str] | None = None, parser: argparse.ArgumentParser | None = None,
          commands: dict | None = None) -> int:
-    """Run one command. ``parser`` and ``commands`` extend the core's (``app.cli`` adds ``serve``:
+    """Run one command. ``parser`` and ``commands`` extend the core's (``cli.main`` adds ``serve``:
     the command line's core knows nothing of the browser app)."""
     argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
     with _one_line_errors(), warnings.catch_warnings(), np.errstate(all="ignore"):

@@ -13,7 +13,7 @@ percentiles of |K| and η at every point are those of the samples. The draws:
   fit's standard errors and correlation; α is kept within (0.001, 1].
 
 The first-order propagation is the check where the spread is small: σ² = g Σ gᵀ with g the
-derivatives of |K| (or η) from :func:`core.sensitivity.log_derivatives` and Σ the draws'
+derivatives of |K| (or η) from :func:`core.whatif.sensitivity.log_derivatives` and Σ the draws'
 covariance.
 """
 
@@ -29,11 +29,11 @@ from typing import Any
 import numpy as np
 from scipy import linalg, stats
 
-from .bushing import MAX_STRAIN, factors, shape_factor, stiffness_points, strain_factor
-from .data import loss_factor
-from .design import Design, DesignError, Geometry, strict_json
-from .fit import FitResult, parameter
-from .material import fractional_modulus, friction_modulus
+from ..bushing import MAX_STRAIN, factors, shape_factor, stiffness_points, strain_factor
+from ..data import loss_factor
+from ..design import Design, DesignError, Geometry, strict_json
+from ..identify.fit import FitResult, parameter
+from ..material import fractional_modulus, friction_modulus
 from .sensitivity import GEOMETRY_PARAMETERS, SENSITIVITY_PARAMETERS, log_derivatives, value_of
 
 DISTRIBUTIONS = ("uniform", "normal")
@@ -56,7 +56,7 @@ class ToleranceError(ValueError):
 @dataclass(frozen=True)
 class FitCovariance:
     """A fit's uncertainty of the material: standard errors (natural units) and the correlation
-    of the fitted (log) parameters, as :class:`core.fit.FitResult` reports them."""
+    of the fitted (log) parameters, as :class:`core.identify.fit.FitResult` reports them."""
 
     standard_errors: dict[str, float]
     correlation: dict[str, dict[str, float]]

@@ -6,8 +6,8 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-from ..design import Design
-from ..effects import EFFECTS, effect_of, split_id
+from ...design import Design
+from ...effects import EFFECTS, effect_of, split_id
 from ..fit import with_values
 
 BRANCHES = ("elastic", "fractional", "friction")

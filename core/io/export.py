@@ -23,10 +23,10 @@ import math
 
 import numpy as np
 
-from .bushing import UNITS, stiffness_points, strain_factor
-from .card import CARD_MODES, card_design
-from .data import csv_text
-from .design import Design
+from ..bushing import UNITS, stiffness_points, strain_factor
+from ..card import CARD_MODES, card_design
+from ..data import csv_text
+from ..design import Design
 
 MAX_EXPORT_POINTS = 100_000  # frequencies × amplitudes of one export
 

@@ -9,9 +9,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..data import MAX_FIT_POINTS, MeasuredStiffness
-from ..design import Design
-from ..effects import effect_of, split_id
+from ...data import MAX_FIT_POINTS, MeasuredStiffness
+from ...design import Design
+from ...effects import effect_of, split_id
+from ...material import ConvergenceError
 from ..fit import (
     fit_global,
     gap,
@@ -21,7 +22,6 @@ from ..fit import (
     parameter_values,
     relative_residual,
 )
-from ..material import ConvergenceError
 from .model import BRANCHES, Model, baseline_model, candidates, fitting_names
 from .report import Diagnosis, Fitted, Step
 from .statistics import (

@@ -30,11 +30,11 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares, minimize
 
-from .bushing import MAX_STRAIN, UNITS, stiffness_points, strain_factor
-from .data import loss_factor
-from .design import MODES, SIZE_RANGE, Design, DesignError, design_from_dict, strict_json
-from .fit import PARAMETERS as MATERIAL_PARAMETERS
-from .fit import parameter
+from ..bushing import MAX_STRAIN, UNITS, stiffness_points, strain_factor
+from ..data import loss_factor
+from ..design import MODES, SIZE_RANGE, Design, DesignError, design_from_dict, strict_json
+from ..identify.fit import PARAMETERS as MATERIAL_PARAMETERS
+from ..identify.fit import parameter
 
 QUANTITIES = ("magnitude", "loss_factor")
 GEOMETRY_LIMITS = ("inner_radius", "outer_radius", "length", "thickness")

@@ -8,8 +8,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..data import MeasuredStiffness, loss_factor
-from ..design import Design
+from ...data import MeasuredStiffness, loss_factor
+from ...design import Design
 from ..fit import FitResult
 from .model import Model
 from .statistics import BIC_THRESHOLD

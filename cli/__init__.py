@@ -1,0 +1,1 @@
+"""The ``bushing`` command line: an interface beside the app, over the core (docs/files.md)."""
