@@ -99,7 +99,11 @@ def fractional_modulus(frequency_hz, fractional_coefficient: float, fractional_o
 
 
 def equivalent_modulus(material: Material, frequency_hz, strain_amplitude):
-    """µ_eq(ω, ε̂) = µ + m (iω)^α / 2 + µ_f(ε̂) in Pa, broadcast over the two arrays (eq 16)."""
+    """µ_eq(ω, ε̂) = µ + m (iω)^α / 2 + µ_f(ε̂) in Pa, broadcast over the two arrays (eq 16).
+
+    ``material`` is a :class:`Material`, or any object with its five fields as arrays that
+    broadcast with the two arguments (e.g. one value per Monte Carlo sample, shaped (n, 1, …),
+    as :mod:`core.whatif.tolerance` gives): the result then has a row per sample."""
     return (
         material.shear_modulus
         + fractional_modulus(
