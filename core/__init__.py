@@ -4,17 +4,7 @@ Dynamic stiffness of carbon-black-filled rubber bushings in torsion and axially,
 frequency and amplitude, after García Tárrago (KTH, 2006). See docs/model.md for the physics.
 """
 
-from .bushing import (
-    HistoryResult,
-    LoopResult,
-    StiffnessResult,
-    force_history,
-    loop,
-    shape_factor,
-    stiffness,
-    stiffness_points,
-    strain_factor,
-)
+from .bushing import StiffnessResult, shape_factor, stiffness, stiffness_points, strain_factor
 from .design import (
     PAPER_B,
     TABLE_1,
@@ -27,6 +17,7 @@ from .design import (
     read_design,
     write_design,
 )
+from .loops import HistoryResult, LoopResult, force_history, loop
 from .material import ConvergenceError, equivalent_modulus, equivalent_modulus_time_domain
 
 __all__ = [

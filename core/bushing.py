@@ -1,4 +1,5 @@
-"""Bushing dynamic stiffness, hysteresis loops and force histories (eqs 10–18).
+"""Bushing dynamic stiffness on a frequency × amplitude grid (eqs 14–18); the hysteresis loops
+and force histories are in :mod:`core.loops`.
 
 ======== ================== ======================================================
 symbol   name here          meaning
@@ -8,9 +9,9 @@ K        shape_factor · µ   stiffness from the equivalent modulus (eq 17 torsi
 φ, d     amplitude          peak angle (rad, torsion) or peak displacement (m, axial)
 ======== ================== ======================================================
 
-The drive x(t) (angle or displacement) maps to the equivalent strain ε_eq = c·x, the material
-turns that into a stress σ(t), and the moment or force is F = S·σ / (2c), where S is the shape
-factor, so that F = S·µ·x for a purely elastic material.
+The drive amplitude x̂ maps to the equivalent strain amplitude ε_eq = c·x̂ (:meth:`Design.strain`),
+the material gives µ_eq(ω, ε_eq) (eq 16) and K = S·µ_eq (:func:`equivalent_stiffness`); slices,
+the continuum (:mod:`core.slices`) and the stiffness-level effects (:mod:`core.effects`) refine it.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from . import material as mat
 from .data import ComplexStiffness, loss_factor
 from .design import Design
 from .effects import EFFECTS, branch_moduli, extended_modulus, inertia_correction, wave_stiffness
-from .shape import shape_factor, strain_factor
+from .shape import shape_factor, strain_factor  # noqa: F401 (re-exported)
 from .slices import continuum_node_count, continuum_nodes, slice_nodes, solve_series
 
 UNITS = {
@@ -40,9 +41,9 @@ ROUTES = ("analytic", "time-domain")
 
 
 def factors(design: Design) -> tuple[float, float]:
-    """(S, c) of a design: its shape factor and strain factor."""
-    return (shape_factor(design.geometry, design.mode, design.shape),
-            strain_factor(design.geometry, design.mode, design.shape))
+    """(S, c) of a design: its shape factor and strain factor (:attr:`Design.shape_factor`,
+    :attr:`Design.strain_factor`)."""
+    return design.shape_factor, design.strain_factor
 
 
 # --------------------------------------------------------------------------------------------
@@ -50,7 +51,9 @@ def factors(design: Design) -> tuple[float, float]:
 # --------------------------------------------------------------------------------------------
 
 
-def _grid(name: str, values) -> np.ndarray:
+def positive_values(name: str, values) -> np.ndarray:
+    """``values`` as a 1-d float array of one or more positive finite numbers, or ValueError
+    naming ``name``."""
     arr = np.atleast_1d(np.asarray(values, dtype=float))
     if arr.ndim != 1 or arr.size == 0:
         raise ValueError(f"{name}: give one or more values")
@@ -184,10 +187,9 @@ def check_strain(design: Design, amplitude, what: str = "amplitude") -> None:
     """Refuse drive amplitudes whose equivalent strain is beyond :data:`MAX_STRAIN`: no rubber
     survives them, and the formulas' numbers stop being meaningful long before floats fail."""
     x = np.asarray(amplitude, dtype=float)
-    c = strain_factor(design.geometry, design.mode, design.shape)
-    if x.size and float(np.max(c * x)) > MAX_STRAIN:
+    if x.size and float(np.max(design.strain(x))) > MAX_STRAIN:
         unit = UNITS[design.mode]["amplitude"]
-        largest = MAX_STRAIN / c
+        largest = design.drive(MAX_STRAIN)
         raise ValueError(f"{what}: at most {largest:.4g} {unit} for this bushing (an equivalent strain of "
                          f"{MAX_STRAIN:g}, {100 * MAX_STRAIN:g} %); got {float(np.max(x)):.4g} {unit}")
 
@@ -197,12 +199,22 @@ def check_measured_amplitude(design: Design, amplitude, what: str = "measured am
     equivalent strains from :data:`MIN_MEASURED_STRAIN` to :data:`MAX_STRAIN`."""
     check_strain(design, amplitude, what)
     x = np.asarray(amplitude, dtype=float)
-    c = strain_factor(design.geometry, design.mode, design.shape)
-    if x.size and float(np.min(c * x)) < MIN_MEASURED_STRAIN:
+    if x.size and float(np.min(design.strain(x))) < MIN_MEASURED_STRAIN:
         unit = UNITS[design.mode]["amplitude"]
-        raise ValueError(f"{what}: at least {MIN_MEASURED_STRAIN / c:.3g} {unit} for this bushing (an equivalent "
+        smallest = design.drive(MIN_MEASURED_STRAIN)
+        raise ValueError(f"{what}: at least {smallest:.3g} {unit} for this bushing (an equivalent "
                          f"strain of {MIN_MEASURED_STRAIN:g}, below any test's resolution); got "
                          f"{float(np.min(x)):.3g} {unit}: are the units those of docs/files.md (m or rad)?")
+
+
+def equivalent_stiffness(modulus, s, c, frequency_hz, amplitude):
+    """K = S·µ_eq(f, ε_eq) at ε_eq = c·x̂: the single equivalent modulus (eqs 14–18), broadcast
+    over every argument. ``modulus`` is µ_eq(frequency_hz, strain_amplitude) in Pa (e.g.
+    :func:`modulus_function`'s, or :func:`core.material.equivalent_modulus` of a material);
+    ``s`` the shape factor (m or m³/rad) and ``c`` the strain factor (1/m or 1/rad). S, c and the
+    parameters inside ``modulus`` may be arrays, e.g. one value per Monte Carlo sample shaped
+    (n, 1, …) against the points; the drive ``amplitude`` is in m or rad."""
+    return s * modulus(frequency_hz, c * amplitude)  # eqs 14, 15 inside, 17, 18 outside
 
 
 def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | str = 1,
@@ -231,14 +243,14 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
                 "modulus; they cannot be combined with slices, the continuum or nonuniform_strain"
             )
         k = wave_stiffness(mode, geo.inner_radius, geo.outer_radius, geo.length,
-                           modulus(f, c * x), f, effects["wave_effects"]["density"])
+                           modulus(f, design.strain(x)), f, effects["wave_effects"]["density"])
     elif slices == 1:
-        k = s * modulus(f, c * x)  # eqs 16–18
+        k = equivalent_stiffness(modulus, s, c, f, x)
     else:
         nodes = continuum_nodes(geo, mode) if slices == "continuum" else slice_nodes(geo, mode, slices)
         fp, xp = (np.broadcast_to(v, shape).ravel() for v in (f, x))
         k = solve_series(nodes, drive=xp, modulus=lambda eps: modulus(fp[:, None], eps),
-                         strain_guess=c * xp).reshape(shape)
+                         strain_guess=design.strain(xp)).reshape(shape)
     if "inertia" in effects:
         k = inertia_correction(k, f, effects["inertia"]["mass"])
     k = np.broadcast_to(k, shape)
@@ -280,8 +292,8 @@ def stiffness(
     Returns a :class:`StiffnessResult`; repeated queries come from a bounded cache.
     Raises :class:`core.material.ConvergenceError` if an iteration does not converge.
     """
-    f = _grid("frequency_hz", frequency_hz)
-    x = _grid("amplitude", amplitude)
+    f = positive_values("frequency_hz", frequency_hz)
+    x = positive_values("amplitude", amplitude)
     slices = _check_slices(slices)
     if route not in ROUTES:
         raise ValueError(f"route: must be one of {', '.join(ROUTES)}, got {route!r}")
@@ -295,12 +307,11 @@ def branch_stiffness(design: Design, frequency_hz, amplitude) -> dict[str, np.nd
     ``rate_amplitude_coupling``). Their sum is :func:`stiffness` for a design without
     stiffness-level effects (inertia, waves, non-uniform strain), which are refused here.
     """
-    _refuse_structural_effects(design, "the branch-by-branch stiffness")
-    f = _grid("frequency_hz", frequency_hz)[None, :]
-    x = _grid("amplitude", amplitude)[:, None]
-    s, c = factors(design)
-    eps = c * x
-    return {name: s * modulus for name, modulus in
+    refuse_structural_effects(design, "the branch-by-branch stiffness")
+    f = positive_values("frequency_hz", frequency_hz)[None, :]
+    x = positive_values("amplitude", amplitude)[:, None]
+    s, eps = design.shape_factor, design.strain(x)
+    return {name: s * modulus for name, modulus in  # eqs 17, 18 branch by branch
             branch_moduli(design.material, design.effect_parameters, f, eps).items()}
 
 
@@ -310,116 +321,8 @@ def cache_info():
 
 
 # --------------------------------------------------------------------------------------------
-# Hysteresis loop and force histories
+# Material model and structural effects
 # --------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, eq=False)
-class LoopResult:
-    """One steady period of the hysteresis loop: drive x(θ) = x̂ sin θ, θ = 2πk/N, k < N.
-
-    Forces in N (axial) or N·m (torsion), displacement in m or rad.
-    """
-
-    design: Design
-    frequency_hz: float
-    amplitude: float
-    phase: np.ndarray
-    displacement: np.ndarray
-    force_elastic: np.ndarray
-    force_viscoelastic: np.ndarray
-    force_friction: np.ndarray
-
-    @property
-    def force(self) -> np.ndarray:
-        return self.force_elastic + self.force_viscoelastic + self.force_friction
-
-    @property
-    def units(self) -> dict[str, str]:
-        return UNITS[self.design.mode]
-
-    def table(self) -> dict[str, np.ndarray]:
-        return {
-            "displacement": self.displacement,
-            "force": self.force,
-            "force_elastic": self.force_elastic,
-            "force_viscoelastic": self.force_viscoelastic,
-            "force_friction": self.force_friction,
-        }
-
-
-def steady_friction_loop(strain_amplitude: float, phase, friction_stress_max, friction_strain_half):
-    """Steady Berg friction stress along ε = ε̂ sin θ, in closed form (docs/model.md, route 2).
-
-    Rising branch (cos θ ≥ 0): σ = σ_fmax [1 − ε½ (1 + x)² / (ε½ (1 + x) + ε̂ + ε)];
-    falling branch: σ(ε) = −σ_rising(−ε); x from :func:`core.material.friction_reversal_ratio`.
-    """
-    phase = np.asarray(phase, dtype=float)
-    eps = strain_amplitude * np.sin(phase)
-    x = mat.friction_reversal_ratio(strain_amplitude / friction_strain_half)
-    h = friction_strain_half
-    rising = np.cos(phase) >= 0.0
-    e = np.where(rising, eps, -eps)
-    branch = friction_stress_max * (1.0 - h * (1.0 + x) ** 2 / (h * (1.0 + x) + strain_amplitude + e))
-    return np.where(rising, branch, -branch)
-
-
-def loop(
-    design: Design,
-    frequency_hz: float,
-    amplitude: float,
-    points: int = 256,
-    *,
-    route: Route = "analytic",
-) -> LoopResult:
-    """One steady period of force (moment) against displacement (angle), branch by branch.
-
-    ``route="analytic"`` builds the steady loop in closed form (elastic line, the fractional
-    ellipse Im(m(iω)^α ε̂ e^{iθ}), the Berg loop of :func:`steady_friction_loop`);
-    ``route="time-domain"`` simulates from rest until the steady state and returns the last
-    period (the same convergence rule as the time-domain modulus).
-    """
-    f = float(_grid("frequency_hz", frequency_hz)[0])
-    xa = float(_grid("amplitude", amplitude)[0])
-    check_strain(design, xa)
-    if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 4:
-        raise ValueError(f"points: must be a whole number ≥ 4, got {points!r}")
-    _refuse_structural_effects(design, "the branch-by-branch hysteresis loop")
-    theta = 2.0 * np.pi * np.arange(points) / points
-    if route == "analytic":
-        forces = loop_force(design, f, xa, theta)
-    elif route == "time-domain":
-        s, c = factors(design)
-        scale = s / (2.0 * c)  # F = S σ / (2c)
-        stresses = _time_domain_loop(design.material, design.effect_parameters, f, c * xa, points)
-        forces = tuple(scale * part for part in stresses)
-    else:
-        raise ValueError(f"route: must be one of {', '.join(ROUTES)}, got {route!r}")
-    return LoopResult(design, f, xa, theta, xa * np.sin(theta), *forces)
-
-
-def loop_force(design: Design, frequency_hz: float, amplitude: float, phase):
-    """Steady force (moment) branches at the drive phases θ, x = x̂ sin θ, in closed form:
-    (elastic, viscoelastic, friction), each in N or N·m. The viscoelastic branch is linear:
-    Im(2 µ_ve ε̂ e^{iθ}) with its branch modulus µ_ve (:func:`core.effects.branch_moduli`: the
-    fractional term and any viscous one). The friction branch is the steady Berg loop scaled as
-    its branch modulus is by the effects (µ_f → µ_f (f/10 Hz)^γ). The elastic branch is the
-    waveform 2µε(1 + βε²) with strain stiffening (its first harmonic is the elastic branch
-    modulus µ(1 + ¾βε̂²); the third harmonic the closed form leaves out is drawn here)."""
-    m = design.material
-    effects = design.effect_parameters
-    s, c = factors(design)
-    scale = s / (2.0 * c)  # F = S σ / (2c)
-    eps_amp = c * amplitude
-    theta = np.asarray(phase, dtype=float)
-    eps = eps_amp * np.sin(theta)
-    moduli = branch_moduli(m, effects, frequency_hz, eps_amp)
-    el = 2.0 * m.shear_modulus * eps * (1.0 + effects.get("strain_stiffening", {}).get("stiffening", 0.0) * eps**2)
-    fr = np.imag(2.0 * complex(moduli["viscoelastic"]) * eps_amp * np.exp(1j * theta))
-    fric = steady_friction_loop(eps_amp, theta, m.friction_stress_max, m.friction_strain_half)
-    base_friction = mat.friction_modulus(eps_amp, m.friction_stress_max, m.friction_strain_half)
-    fric = fric * (complex(moduli["friction"]) / complex(base_friction)).real
-    return scale * el, scale * fr, scale * fric
 
 
 STRUCTURAL_EFFECTS = ("inertia", "nonuniform_strain", "wave_effects")
@@ -432,79 +335,12 @@ def material_model(design: Design) -> Design:
     return design if len(kept) == len(design.effects) else design.replace(effects=kept)
 
 
-def _refuse_structural_effects(design: Design, what: str, allowed=()):
+def refuse_structural_effects(design: Design, what: str, allowed=()) -> None:
+    """ValueError if ``design`` has a stiffness-level effect (:data:`STRUCTURAL_EFFECTS`) other
+    than those ``allowed``: ``what`` is computed from the material branches."""
     for eid in STRUCTURAL_EFFECTS:
         if eid in design.effect_parameters and eid not in allowed:
             raise ValueError(
                 f"effects.{eid}: {what} is computed from the material branches; it is not "
                 f"available for a design with this effect (use the stiffness instead)"
             )
-
-
-def _time_domain_loop(material, effects, frequency_hz, eps_amp, points):
-    """Last period of the simulated stresses, on the loop's phase grid θ = 2πk/points."""
-    td = mat.equivalent_modulus_time_domain(material, frequency_hz, eps_amp, effects=effects)
-    n_p = max(td.samples_per_period, points)
-    n_p = int(points * -(-n_p // points))  # a multiple of points
-    n = td.periods * n_p
-    theta = 2.0 * np.pi * np.arange(1, n + 1) / n_p
-    br = mat.branch_stresses(
-        material, eps_amp * np.sin(theta), 1.0 / (frequency_hz * n_p), effects, frequency_hz
-    )
-    # last period, starting at θ ≡ 0: samples n − n_p … n − 1 are θ = 2π(k + 1)/n_p; take
-    # the sample with k + 1 ≡ 0 first
-    last = slice(n - n_p - 1, n - 1)
-    step = n_p // points
-    return (br.elastic[last][::step], br.fractional[last][::step], br.friction[last][::step])
-
-
-@dataclass(frozen=True, eq=False)
-class HistoryResult:
-    """Force (moment) history for a sampled displacement (angle) history, branch by branch."""
-
-    design: Design
-    time_s: np.ndarray
-    displacement: np.ndarray
-    force_elastic: np.ndarray
-    force_viscoelastic: np.ndarray
-    force_friction: np.ndarray
-    force_inertia: np.ndarray  # M·d²x/dt² of the ``inertia`` effect, zero without it
-
-    @property
-    def force(self) -> np.ndarray:
-        return self.force_elastic + self.force_viscoelastic + self.force_friction + self.force_inertia
-
-
-def force_history(design: Design, displacement, dt: float) -> HistoryResult:
-    """Force (N) or moment (N·m) for any displacement (m) or angle (rad) history sampled every
-    ``dt`` seconds, e.g. from a multibody simulation. O(N log N): the fractional memory is an
-    FFT convolution (eq 3), the friction state changes only at reversals (eq 6).
-
-    The history starts from rest in the virgin state at zero displacement; a first sample away
-    from zero is reached by a step from zero. Material-level effects are simulated (except
-    ``rate_amplitude_coupling``, defined for harmonic drives only); ``inertia`` adds M·d²x/dt²
-    to the total force; ``nonuniform_strain`` and ``wave_effects`` are refused.
-    """
-    x = np.asarray(displacement, dtype=float)
-    if x.ndim != 1 or x.size == 0 or not np.all(np.isfinite(x)):
-        raise ValueError("displacement: give a one-dimensional array of finite numbers")
-    if not (np.isfinite(dt) and dt > 0):
-        raise ValueError(f"dt: must be a positive finite number, got {dt!r}")
-    _refuse_structural_effects(design, "the force history", allowed=("inertia",))
-    effects = design.effect_parameters
-    s, c = factors(design)
-    scale = s / (2.0 * c)
-    br = mat.branch_stresses(design.material, c * x, dt, effects)
-    inertial = np.zeros_like(x)
-    if "inertia" in effects:  # from rest at zero: x_{-1} = x_{-2} = 0
-        padded = np.concatenate(([0.0, 0.0], x))
-        inertial = effects["inertia"]["mass"] * np.diff(padded, 2) / dt**2
-    return HistoryResult(
-        design,
-        dt * np.arange(x.size),
-        x,
-        scale * br.elastic,
-        scale * br.fractional,
-        scale * br.friction,
-        inertial,
-    )

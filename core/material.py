@@ -99,7 +99,11 @@ def fractional_modulus(frequency_hz, fractional_coefficient: float, fractional_o
 
 
 def equivalent_modulus(material: Material, frequency_hz, strain_amplitude):
-    """µ_eq(ω, ε̂) = µ + m (iω)^α / 2 + µ_f(ε̂) in Pa, broadcast over the two arrays (eq 16)."""
+    """µ_eq(ω, ε̂) = µ + m (iω)^α / 2 + µ_f(ε̂) in Pa, broadcast over the two arrays (eq 16).
+
+    ``material`` is a :class:`Material`, or any object with its five fields as arrays that
+    broadcast with the two arguments (e.g. one value per Monte Carlo sample, shaped (n, 1, …),
+    as :mod:`core.whatif.tolerance` gives): the result then has a row per sample."""
     return (
         material.shear_modulus
         + fractional_modulus(
@@ -179,6 +183,16 @@ def friction_stress(strain, friction_stress_max: float, friction_strain_half: fl
     return ss + u * (smax - s * ss) / (ehalf * (1.0 - s * ss / smax) + s * u)
 
 
+def elastic_stress(material: Material, strain, effects: Mapping | None = None):
+    """Elastic-branch stress in Pa at the (tensor shear) strain ``strain``: σ_el = 2µε (eq 1), or
+    2µε(1 + βε²) with the ``strain_stiffening`` effect (docs/model.md). Arrays too."""
+    strain = np.asarray(strain, dtype=float)
+    elastic = 2.0 * material.shear_modulus * strain  # eq 1
+    if effects and "strain_stiffening" in effects:
+        elastic = elastic * (1.0 + effects["strain_stiffening"]["stiffening"] * strain**2)
+    return elastic
+
+
 @dataclass(frozen=True)
 class BranchStresses:
     """Stress histories along one strain path, in Pa: the elastic branch (with
@@ -210,9 +224,7 @@ def branch_stresses(
     """
     strain = np.asarray(strain, dtype=float)
     effects = effects or {}
-    elastic = 2.0 * material.shear_modulus * strain  # eq 1
-    if "strain_stiffening" in effects:
-        elastic = elastic * (1.0 + effects["strain_stiffening"]["stiffening"] * strain**2)
+    elastic = elastic_stress(material, strain, effects)
     visco = fractional_stress(strain, dt, material.fractional_coefficient, material.fractional_order)
     if "viscous" in effects:
         visco = visco + effects["viscous"]["viscosity"] * np.gradient(

@@ -11,9 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .bushing import loop_force, stiffness_points
+from .bushing import stiffness_points
 from .data import MeasuredLoop, MeasuredStiffness
 from .design import PAPER_B, TABLE_1, Design
+from .loops import loop_force
 
 
 def synthetic_stiffness(design: Design, frequency_hz, amplitude, *, noise: float = 0.005,

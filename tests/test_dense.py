@@ -11,10 +11,10 @@ from numpy.testing import assert_allclose
 
 from cli.commands import Progress
 from core import PAPER_B, stiffness_points
-from core.bushing import loop_force
 from core.data import MeasuredStiffness
 from core.identify.diagnose import diagnose
 from core.identify.fit import fit_global, folded, gap, parameter_values
+from core.loops import loop_force
 from core.synthetic import synthetic_loop, synthetic_stiffness
 
 AMPLITUDES = [0.013e-3, 0.04e-3, 0.1e-3, 0.17e-3, 0.35e-3]

@@ -8,7 +8,7 @@ from numpy.testing import assert_allclose
 from scipy import integrate, special
 
 from core import PAPER_B, TABLE_1, ConvergenceError, strain_factor
-from core.bushing import steady_friction_loop
+from core.loops import steady_friction_loop
 from core.material import (
     equivalent_modulus,
     equivalent_modulus_time_domain,

@@ -1,6 +1,7 @@
 """Supplier what-ifs: tolerance bands (against first-order propagation and the exact extremes),
 sensitivities (against finite differences and the closed forms), designs found from targets."""
 
+import itertools
 import json
 
 import numpy as np
@@ -10,14 +11,21 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cli.main import main
-from core import PAPER_B, TABLE_1, write_design
-from core.bushing import stiffness_points
+from core import PAPER_B, TABLE_1, stiffness, write_design
+from core.bushing import MAX_STRAIN, stiffness_points
 from core.data import loss_factor
 from core.identify.fit import PARAMETERS, fit_global, parameter
 from core.synthetic import synthetic_stiffness
 from core.whatif.sensitivity import elasticities, log_derivatives, sentence, value_of
 from core.whatif.target import TargetError, problem_from_dict, solve
-from core.whatif.tolerance import FitCovariance, ToleranceError, Tolerances, band, loads_tolerances
+from core.whatif.tolerance import (
+    FitCovariance,
+    ToleranceError,
+    Tolerances,
+    band,
+    loads_tolerances,
+    sample_stiffness,
+)
 
 F = np.linspace(1, 100, 40)
 
@@ -337,6 +345,54 @@ def test_the_vectorised_band_is_the_sample_by_sample_one(mode):
         np.testing.assert_allclose(fast.magnitude[q], slow.magnitude[q], rtol=1e-12)
         np.testing.assert_allclose(fast.loss_factor[q], slow.loss_factor[q], rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(fast.std_magnitude, slow.std_magnitude, rtol=1e-9)
+
+
+@pytest.mark.parametrize("mode", ["axial", "torsion", "radial", "conical"])
+def test_a_band_of_zero_tolerances_is_the_nominal_stiffness(mode):
+    """Every sample is the nominal design: each percentile is |K| and η of stiffness() on its grid."""
+    design = PAPER_B.in_mode(mode)
+    x = np.geomspace(1e-6, 1e-3, 4) * (1 if mode in ("axial", "radial") else 100)
+    b = band(design, F[None, :], x[:, None], Tolerances({"shear_modulus": 0.0, "length": 0.0}, samples=10))
+    k = stiffness(design, F, x).stiffness
+    for q in b.percentiles:
+        np.testing.assert_allclose(b.magnitude[q], np.abs(k), rtol=1e-13)
+        np.testing.assert_allclose(b.loss_factor[q], loss_factor(k), rtol=1e-13)
+
+
+@pytest.mark.parametrize("mode", ["axial", "torsion", "radial", "conical"])
+def test_each_sample_of_a_band_is_the_model_at_its_drawn_design(mode):
+    """The band's samples, all at once, are stiffness_points of each drawn design, point by point."""
+    tol = Tolerances({"shear_modulus": 0.1, "fractional_coefficient": 0.1, "fractional_order": 0.1,
+                      "friction_stress_max": 0.1, "friction_strain_half": 0.2, "inner_radius": 0.05,
+                      "outer_radius": 0.05, "length": 0.05}, samples=10, seed=11)
+    design = PAPER_B.in_mode(mode)
+    f, x = F[::10], np.geomspace(1e-6, 1e-3, 3) * (1 if mode in ("axial", "radial") else 100)
+    draws = tol.draws(design)
+    k = sample_stiffness(design, draws, f[None, :], x[:, None])
+    assert k.shape == (10, x.size, f.size)
+    for i, values in enumerate(draws):
+        drawn = design.replace(**values)
+        for (a, xa), (j, fj) in itertools.product(enumerate(x), enumerate(f)):
+            np.testing.assert_allclose(k[i, a, j], complex(stiffness_points(drawn, fj, xa)), rtol=1e-13)
+
+
+def test_a_band_refuses_strains_by_the_models_own_check():
+    """A sample driven beyond MAX_STRAIN is refused with core.bushing's reason for that sample's
+    design, the same by the vectorised band as by the sample-by-sample one (a zero viscous effect)."""
+    tol = Tolerances({"inner_radius": 0.05}, samples=20, seed=4)
+    drawn = [PAPER_B.replace(**values) for values in tol.draws(PAPER_B)]
+    limits = [d.drive(MAX_STRAIN) for d in drawn]  # each sample's largest drive
+    first, second = np.sort(limits)[:2]
+    x = 0.5 * (first + second)  # beyond one sample's limit only; within the nominal design's
+    assert x < PAPER_B.drive(MAX_STRAIN)
+    worst = int(np.argmin(limits))
+    with pytest.raises(ValueError) as model:
+        stiffness_points(drawn[worst], F, x)
+    for design in (PAPER_B, PAPER_B.replace(effects={"viscous": {"viscosity": 0.0}})):
+        with pytest.raises(ToleranceError) as refused:
+            band(design, F, x, tol)
+        assert str(refused.value) == (f"sample {worst + 1}: within these tolerances the bushing leaves what "
+                                      f"the model computes: {model.value}")
 
 
 @pytest.mark.parametrize("text, match", [

@@ -23,9 +23,9 @@ import math
 
 import numpy as np
 
-from ..bushing import UNITS, stiffness_points, strain_factor
+from ..bushing import UNITS, stiffness_points
 from ..card import CARD_MODES, card_design
-from ..data import csv_text
+from ..data import csv_text, loss_factor
 from ..design import Design
 
 MAX_EXPORT_POINTS = 100_000  # frequencies × amplitudes of one export
@@ -39,11 +39,11 @@ def direction_grid(design: Design, frequency_hz, amplitude) -> dict:
         raise ValueError(f"an export holds at most {MAX_EXPORT_POINTS} frequencies × amplitudes; asked "
                          f"{f.size} × {x.size}")
     own = card_design(design, design.mode)  # the design's direction keeps the given amplitudes exactly
-    eps = strain_factor(own.geometry, own.mode, own.shape) * x
+    eps = own.strain(x)
     out = {"frequency_hz": f, "strain": eps}
     for mode in CARD_MODES:
         d = card_design(design, mode)
-        amp = eps / strain_factor(d.geometry, mode, d.shape)
+        amp = d.drive(eps)
         k = stiffness_points(d, f[None, :], amp[:, None])
         if not np.all(np.isfinite(k)):
             raise ValueError(f"the {mode} stiffness is not finite on this grid")
@@ -58,6 +58,7 @@ def table_csv(grid: dict) -> str:
                             "stiffness_imag", "magnitude", "stiffness_unit", "loss_factor")}
     for mode in CARD_MODES:
         k = grid[mode]["stiffness"]
+        eta = loss_factor(k)
         for i, amp in enumerate(grid[mode]["amplitude"]):
             for j, f in enumerate(grid["frequency_hz"]):
                 cols["mode"].append(mode)
@@ -68,7 +69,7 @@ def table_csv(grid: dict) -> str:
                 cols["stiffness_imag"].append(k[i, j].imag)
                 cols["magnitude"].append(abs(k[i, j]))
                 cols["stiffness_unit"].append(UNITS[mode]["stiffness"])
-                cols["loss_factor"].append(k[i, j].imag / k[i, j].real)
+                cols["loss_factor"].append(eta[i, j])
     return csv_text(cols)
 
 
@@ -87,7 +88,7 @@ def table_json(grid: dict, design: Design) -> str:
         out["directions"][mode] = {
             "amplitude_unit": UNITS[mode]["amplitude"], "stiffness_unit": UNITS[mode]["stiffness"],
             "amplitude": grid[mode]["amplitude"].tolist(), "stiffness_real": k.real.tolist(),
-            "stiffness_imag": k.imag.tolist(), "magnitude": np.abs(k).tolist(), "loss_factor": (k.imag / k.real).tolist(),
+            "stiffness_imag": k.imag.tolist(), "magnitude": np.abs(k).tolist(), "loss_factor": loss_factor(k).tolist(),
         }
     return json.dumps(out, indent=1, allow_nan=False) + "\n"
 
@@ -137,13 +138,13 @@ def nastran(grid: dict, design: Design, first_id: int = 1) -> str:
         amps = ", ".join(f"{m} {grid[m]['amplitude'][i]:.4g} {UNITS[m]['amplitude']}" for m in CARD_MODES)
         lines.append(f"$ PID {pid}: equivalent strain {grid['strain'][i]:.4g} ({amps})")
         lines += _card("PBUSH", [str(pid), "K", *(nastran_real(k[m][0].real) for m in NASTRAN_DOF)])
-        lines += _card("", ["", "GE", *(nastran_real(k[m][0].imag / k[m][0].real) for m in NASTRAN_DOF)])
+        lines += _card("", ["", "GE", *(nastran_real(loss_factor(k[m][0])) for m in NASTRAN_DOF)])
         tk = [1000 * pid + 10 * (d + 1) + 1 for d in range(6)]
         tge = [1000 * pid + 10 * (d + 1) + 2 for d in range(6)]
         lines += _card("PBUSHT", [str(pid), "K", *(str(t) for t in tk)])
         lines += _card("", ["", "GE", *(str(t) for t in tge)])
         for d, mode in enumerate(NASTRAN_DOF):
-            for tid, values in ((tk[d], k[mode].real), (tge[d], k[mode].imag / k[mode].real)):
+            for tid, values in ((tk[d], k[mode].real), (tge[d], loss_factor(k[mode]))):
                 pairs = [nastran_real(v) for xy in zip(f, values) for v in xy] + ["ENDT"]
                 lines += _card("TABLED1", [str(tid), "LINEAR", "LINEAR"])
                 lines += _card("", pairs)
@@ -177,7 +178,7 @@ def adams(grid: dict, design: Design, points: int = 5) -> str:
         x = np.linspace(-amp, amp, points)
         for curve, damping in (ADAMS_AXES[mode], *((ADAMS_ALSO[mode],) if mode in ADAMS_ALSO else ())):
             what = "torque" if "TORQUE" in curve else "force"
-            lines += [f"$ {mode}: K' = {k.real:.8g} {UNITS[mode]['stiffness']}, loss factor {k.imag / k.real:.6g}",
+            lines += [f"$ {mode}: K' = {k.real:.8g} {UNITS[mode]['stiffness']}, loss factor {loss_factor(k):.6g}",
                       f"[{curve}]", f"{{ {'rot' if what == 'torque' else 'disp'} {what} }}"]
             lines += [f"{xi:.10g} {k.real * xi:.10g}" for xi in x]
             lines += [f"[{damping}]", f"DAMPING = {k.imag / omega:.10g}"]

@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares, minimize
 
-from ..bushing import MAX_STRAIN, UNITS, stiffness_points, strain_factor
+from ..bushing import MAX_STRAIN, UNITS, stiffness_points
 from ..data import loss_factor
 from ..design import MODES, SIZE_RANGE, Design, DesignError, design_from_dict, strict_json
 from ..identify.fit import PARAMETERS as MATERIAL_PARAMETERS
@@ -212,7 +212,7 @@ class _Evaluator:
             for t in p.targets:
                 for m, x in zip(t.modes, t.amplitudes):
                     d = directions[m]
-                    ineq.append(math.log(MAX_STRAIN / (strain_factor(d.geometry, m, d.shape) * x)))
+                    ineq.append(math.log(MAX_STRAIN / d.strain(x)))
             for t in p.targets:
                 q = t.measure(design, directions)
                 lq = math.log(q) if q > 0 else -50.0

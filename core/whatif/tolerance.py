@@ -24,17 +24,26 @@ import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 from scipy import linalg, stats
 
-from ..bushing import MAX_STRAIN, factors, shape_factor, stiffness_points, strain_factor
+from ..bushing import (
+    check_strain,
+    equivalent_stiffness,
+    factors,
+    shape_factor,
+    stiffness_points,
+    strain_factor,
+)
 from ..data import loss_factor
 from ..design import Design, DesignError, Geometry, strict_json
 from ..identify.fit import FitResult, parameter
-from ..material import fractional_modulus, friction_modulus
-from .sensitivity import GEOMETRY_PARAMETERS, SENSITIVITY_PARAMETERS, log_derivatives, value_of
+from ..material import equivalent_modulus
+from ..parameters import GEOMETRY, MATERIAL
+from .sensitivity import SENSITIVITY_PARAMETERS, log_derivatives, value_of
 
 DISTRIBUTIONS = ("uniform", "normal")
 SAMPLES = 500  # the default sample count
@@ -240,19 +249,7 @@ def band(design: Design, frequency_hz, amplitude, tolerances: Tolerances, **kwar
         raise ToleranceError(f"{tolerances.samples} samples × {points} points is more than {MAX_EVALUATIONS:.3g} "
                              "evaluations: use fewer samples or a coarser grid")
     nominal = np.broadcast_to(stiffness_points(design, f, x, **kwargs), shape)
-    draws = tolerances.draws(design)
-    try:
-        k = _closed_form_samples(design, draws, f, x, shape, **kwargs)
-    except (ValueError, ArithmeticError) as exc:
-        raise ToleranceError(f"within these tolerances the bushing leaves what the model computes: {exc}") from None
-    if k is None:  # effects, slices or the time-domain route: each sample by the general route
-        k = np.empty((tolerances.samples, *shape), dtype=complex)
-        for i, values in enumerate(draws):
-            try:
-                k[i] = stiffness_points(design.replace(**values), f, x, **kwargs)
-            except (ValueError, ArithmeticError) as exc:
-                raise ToleranceError(f"sample {i + 1}: within these tolerances the bushing leaves what the model "
-                                     f"computes: {exc}") from None
+    k = sample_stiffness(design, tolerances.draws(design), f, x, **kwargs)
     magnitude, eta = np.abs(k), loss_factor(k)
     q = tolerances.percentiles
     mq, eq = np.percentile(magnitude, q, axis=0), np.percentile(eta, q, axis=0)
@@ -262,13 +259,46 @@ def band(design: Design, frequency_hz, amplitude, tolerances: Tolerances, **kwar
                 tolerances.distribution)
 
 
+def _refused(exc: Exception, sample: int | None = None) -> ToleranceError:
+    """The band's refusal of a sample (numbered from 1) or of some sample the model refuses."""
+    where = "" if sample is None else f"sample {sample + 1}: "
+    return ToleranceError(f"{where}within these tolerances the bushing leaves what the model computes: {exc}")
+
+
+def sample_stiffness(design: Design, draws: list[dict[str, float]], frequency_hz, amplitude,
+                     **kwargs) -> np.ndarray:
+    """K of every sample, ``design`` with each of ``draws``' values, at the points
+    (``frequency_hz``, ``amplitude`` broadcast, Hz and m or rad): shape (samples, *points), in N/m
+    or N·m/rad. ``kwargs`` go to :func:`core.bushing.stiffness_points` (slices, route). All samples
+    at once where the route is the single equivalent modulus (:func:`_closed_form_samples`), else
+    sample by sample. Raises :class:`ToleranceError` for a sample the model refuses."""
+    f, x = np.asarray(frequency_hz, float), np.asarray(amplitude, float)
+    shape = np.broadcast_shapes(f.shape, x.shape)
+    try:
+        k = _closed_form_samples(design, draws, f, x, shape, **kwargs)
+    except ToleranceError:
+        raise
+    except (ValueError, ArithmeticError) as exc:
+        raise _refused(exc) from None
+    if k is None:  # effects, slices or the time-domain route: each sample by the general route
+        k = np.empty((len(draws), *shape), dtype=complex)
+        for i, values in enumerate(draws):
+            try:
+                k[i] = stiffness_points(design.replace(**values), f, x, **kwargs)
+            except (ValueError, ArithmeticError) as exc:
+                raise _refused(exc, i) from None
+    return k
+
+
 def _closed_form_samples(design: Design, draws: list[dict[str, float]], f, x, shape, slices=1,
                          route: str = "analytic") -> np.ndarray | None:
-    """Every sample's K at once, shape (samples, *shape), by eqs 16–18 with arrays of parameters:
-    K = S (µ + m (iω)^α / 2 + µ_f(c x̂)), the numbers :func:`core.bushing.stiffness_points`
-    gives one design at a time. None where that is not the route (effects, slices, the time
-    domain): the caller then computes sample by sample. Raises ValueError for a sample whose
-    geometry the model refuses or whose strain is beyond :data:`core.bushing.MAX_STRAIN`."""
+    """Every sample's K at once, shape (samples, *shape), by the model's own eqs 14–18 over arrays
+    of parameters: :func:`core.bushing.equivalent_stiffness` of
+    :func:`core.material.equivalent_modulus` with S, c and the material one value per sample, the
+    numbers :func:`core.bushing.stiffness_points` gives one design at a time. None where that is
+    not the route (effects, slices, the time domain): the caller then computes sample by sample.
+    Raises ValueError for a sample whose geometry the model refuses, :class:`ToleranceError` for
+    one whose strain :func:`core.bushing.check_strain` refuses."""
     if design.effects or slices != 1 or route != "analytic":
         return None
     n, ones = len(draws), (1,) * len(shape)
@@ -278,18 +308,24 @@ def _closed_form_samples(design: Design, draws: list[dict[str, float]], f, x, sh
             return np.array([d[name] for d in draws]).reshape((n, *ones))
         return np.full((n, *ones), value_of(design, name))
 
-    geometry_varies = any(name in draws[0] for name in GEOMETRY_PARAMETERS) if draws else False
+    geometry_varies = any(name in draws[0] for name in GEOMETRY) if draws else False
     if geometry_varies:
-        s, c = (v.reshape((n, *ones)) for v in _sample_factors(design.mode, design.shape, tuple(
-            tuple(d.get(name, value_of(design, name)) for name in GEOMETRY_PARAMETERS) for d in draws)))
+        s, c = _sample_factors(design.mode, design.shape, tuple(
+            tuple(d.get(name, value_of(design, name)) for name in GEOMETRY) for d in draws))
+        # the model's strain check on the sample of the largest strain factor (the largest
+        # strains); the nominal design's was checked by the band
+        widest = int(np.argmax(c))
+        try:
+            check_strain(design.replace(**{p: v for p, v in draws[widest].items() if p in GEOMETRY}), x)
+        except ValueError as exc:
+            raise _refused(exc, widest) from None
+        s, c = (v.reshape((n, *ones)) for v in (s, c))
     else:
-        s, c = (np.full((n, *ones), v) for v in factors(design))
-    strain = c * x
-    if strain.size and float(np.max(strain)) > MAX_STRAIN:
-        raise ValueError(f"a sample's equivalent strain reaches {float(np.max(strain)):.3g}, beyond {MAX_STRAIN:g}")
-    modulus = (column("shear_modulus") + fractional_modulus(f, column("fractional_coefficient"), column("fractional_order"))
-               + friction_modulus(strain, column("friction_stress_max"), column("friction_strain_half")))
-    k = np.broadcast_to(s * modulus, (n, *shape))
+        s, c = factors(design)
+    # Material's fields, each one value per sample: equivalent_modulus broadcasts over them
+    material = SimpleNamespace(**{name: column(name) for name in MATERIAL})
+    k = np.broadcast_to(equivalent_stiffness(functools.partial(equivalent_modulus, material), s, c, f, x),
+                        (n, *shape))
     if not np.all(np.isfinite(k)):
         raise ValueError("the stiffness of a sample is not finite")
     return np.array(k)

@@ -1,0 +1,199 @@
+"""Hysteresis loops and force histories of a bushing, branch by branch (eqs 1–7, 14–18).
+
+The drive x(t) (angle or displacement) maps to the equivalent strain ε_eq = c·x
+(:meth:`Design.strain`), the material turns that into a stress σ(t) (:mod:`core.material`), and
+the moment or force is F = S·σ / (2c) (:func:`force_per_stress`), where S is the shape factor, so
+that F = S·µ·x for a purely elastic material.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import material as mat
+from .bushing import ROUTES, UNITS, Route, check_strain, positive_values, refuse_structural_effects
+from .design import Design
+from .effects import branch_moduli
+
+
+def force_per_stress(design: Design) -> float:
+    """S / (2c): the force (N) or moment (N·m) per unit stress (Pa) of the material's branches,
+    F = S·σ / (2c), so that F = S·µ·x for a purely elastic material (σ = 2µε, ε = c·x)."""
+    return design.shape_factor / (2.0 * design.strain_factor)
+
+
+@dataclass(frozen=True, eq=False)
+class LoopResult:
+    """One steady period of the hysteresis loop: drive x(θ) = x̂ sin θ, θ = 2πk/N, k < N.
+
+    Forces in N (axial) or N·m (torsion), displacement in m or rad.
+    """
+
+    design: Design
+    frequency_hz: float
+    amplitude: float
+    phase: np.ndarray
+    displacement: np.ndarray
+    force_elastic: np.ndarray
+    force_viscoelastic: np.ndarray
+    force_friction: np.ndarray
+
+    @property
+    def force(self) -> np.ndarray:
+        return self.force_elastic + self.force_viscoelastic + self.force_friction
+
+    @property
+    def units(self) -> dict[str, str]:
+        return UNITS[self.design.mode]
+
+    def table(self) -> dict[str, np.ndarray]:
+        return {
+            "displacement": self.displacement,
+            "force": self.force,
+            "force_elastic": self.force_elastic,
+            "force_viscoelastic": self.force_viscoelastic,
+            "force_friction": self.force_friction,
+        }
+
+
+def steady_friction_loop(strain_amplitude: float, phase, friction_stress_max, friction_strain_half):
+    """Steady Berg friction stress along ε = ε̂ sin θ, in closed form (docs/model.md, route 2).
+
+    Rising branch (cos θ ≥ 0): σ = σ_fmax [1 − ε½ (1 + x)² / (ε½ (1 + x) + ε̂ + ε)];
+    falling branch: σ(ε) = −σ_rising(−ε); x from :func:`core.material.friction_reversal_ratio`.
+    """
+    phase = np.asarray(phase, dtype=float)
+    eps = strain_amplitude * np.sin(phase)
+    x = mat.friction_reversal_ratio(strain_amplitude / friction_strain_half)
+    h = friction_strain_half
+    rising = np.cos(phase) >= 0.0
+    e = np.where(rising, eps, -eps)
+    branch = friction_stress_max * (1.0 - h * (1.0 + x) ** 2 / (h * (1.0 + x) + strain_amplitude + e))
+    return np.where(rising, branch, -branch)
+
+
+def loop(
+    design: Design,
+    frequency_hz: float,
+    amplitude: float,
+    points: int = 256,
+    *,
+    route: Route = "analytic",
+) -> LoopResult:
+    """One steady period of force (moment) against displacement (angle), branch by branch.
+
+    ``route="analytic"`` builds the steady loop in closed form (elastic line, the fractional
+    ellipse Im(m(iω)^α ε̂ e^{iθ}), the Berg loop of :func:`steady_friction_loop`);
+    ``route="time-domain"`` simulates from rest until the steady state and returns the last
+    period (the same convergence rule as the time-domain modulus).
+    """
+    f = float(positive_values("frequency_hz", frequency_hz)[0])
+    xa = float(positive_values("amplitude", amplitude)[0])
+    check_strain(design, xa)
+    if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 4:
+        raise ValueError(f"points: must be a whole number ≥ 4, got {points!r}")
+    refuse_structural_effects(design, "the branch-by-branch hysteresis loop")
+    theta = 2.0 * np.pi * np.arange(points) / points
+    if route == "analytic":
+        forces = loop_force(design, f, xa, theta)
+    elif route == "time-domain":
+        scale = force_per_stress(design)
+        stresses = _time_domain_loop(design.material, design.effect_parameters, f, design.strain(xa), points)
+        forces = tuple(scale * part for part in stresses)
+    else:
+        raise ValueError(f"route: must be one of {', '.join(ROUTES)}, got {route!r}")
+    return LoopResult(design, f, xa, theta, xa * np.sin(theta), *forces)
+
+
+def loop_force(design: Design, frequency_hz: float, amplitude: float, phase):
+    """Steady force (moment) branches at the drive phases θ, x = x̂ sin θ, in closed form:
+    (elastic, viscoelastic, friction), each in N or N·m. The viscoelastic branch is linear:
+    Im(2 µ_ve ε̂ e^{iθ}) with its branch modulus µ_ve (:func:`core.effects.branch_moduli`: the
+    fractional term and any viscous one). The friction branch is the steady Berg loop scaled as
+    its branch modulus is by the effects (µ_f → µ_f (f/10 Hz)^γ). The elastic branch is the
+    waveform 2µε(1 + βε²) with strain stiffening (its first harmonic is the elastic branch
+    modulus µ(1 + ¾βε̂²); the third harmonic the closed form leaves out is drawn here)."""
+    m = design.material
+    effects = design.effect_parameters
+    scale = force_per_stress(design)
+    eps_amp = design.strain(amplitude)
+    theta = np.asarray(phase, dtype=float)
+    eps = eps_amp * np.sin(theta)
+    moduli = branch_moduli(m, effects, frequency_hz, eps_amp)
+    el = mat.elastic_stress(m, eps, effects)
+    fr = np.imag(2.0 * complex(moduli["viscoelastic"]) * eps_amp * np.exp(1j * theta))
+    fric = steady_friction_loop(eps_amp, theta, m.friction_stress_max, m.friction_strain_half)
+    base_friction = mat.friction_modulus(eps_amp, m.friction_stress_max, m.friction_strain_half)
+    fric = fric * (complex(moduli["friction"]) / complex(base_friction)).real
+    return scale * el, scale * fr, scale * fric
+
+
+
+def _time_domain_loop(material, effects, frequency_hz, eps_amp, points):
+    """Last period of the simulated stresses, on the loop's phase grid θ = 2πk/points."""
+    td = mat.equivalent_modulus_time_domain(material, frequency_hz, eps_amp, effects=effects)
+    n_p = max(td.samples_per_period, points)
+    n_p = int(points * -(-n_p // points))  # a multiple of points
+    n = td.periods * n_p
+    theta = 2.0 * np.pi * np.arange(1, n + 1) / n_p
+    br = mat.branch_stresses(
+        material, eps_amp * np.sin(theta), 1.0 / (frequency_hz * n_p), effects, frequency_hz
+    )
+    # last period, starting at θ ≡ 0: samples n − n_p … n − 1 are θ = 2π(k + 1)/n_p; take
+    # the sample with k + 1 ≡ 0 first
+    last = slice(n - n_p - 1, n - 1)
+    step = n_p // points
+    return (br.elastic[last][::step], br.fractional[last][::step], br.friction[last][::step])
+
+
+@dataclass(frozen=True, eq=False)
+class HistoryResult:
+    """Force (moment) history for a sampled displacement (angle) history, branch by branch."""
+
+    design: Design
+    time_s: np.ndarray
+    displacement: np.ndarray
+    force_elastic: np.ndarray
+    force_viscoelastic: np.ndarray
+    force_friction: np.ndarray
+    force_inertia: np.ndarray  # M·d²x/dt² of the ``inertia`` effect, zero without it
+
+    @property
+    def force(self) -> np.ndarray:
+        return self.force_elastic + self.force_viscoelastic + self.force_friction + self.force_inertia
+
+
+def force_history(design: Design, displacement, dt: float) -> HistoryResult:
+    """Force (N) or moment (N·m) for any displacement (m) or angle (rad) history sampled every
+    ``dt`` seconds, e.g. from a multibody simulation. O(N log N): the fractional memory is an
+    FFT convolution (eq 3), the friction state changes only at reversals (eq 6).
+
+    The history starts from rest in the virgin state at zero displacement; a first sample away
+    from zero is reached by a step from zero. Material-level effects are simulated (except
+    ``rate_amplitude_coupling``, defined for harmonic drives only); ``inertia`` adds M·d²x/dt²
+    to the total force; ``nonuniform_strain`` and ``wave_effects`` are refused.
+    """
+    x = np.asarray(displacement, dtype=float)
+    if x.ndim != 1 or x.size == 0 or not np.all(np.isfinite(x)):
+        raise ValueError("displacement: give a one-dimensional array of finite numbers")
+    if not (np.isfinite(dt) and dt > 0):
+        raise ValueError(f"dt: must be a positive finite number, got {dt!r}")
+    refuse_structural_effects(design, "the force history", allowed=("inertia",))
+    effects = design.effect_parameters
+    scale = force_per_stress(design)
+    br = mat.branch_stresses(design.material, design.strain(x), dt, effects)
+    inertial = np.zeros_like(x)
+    if "inertia" in effects:  # from rest at zero: x_{-1} = x_{-2} = 0
+        padded = np.concatenate(([0.0, 0.0], x))
+        inertial = effects["inertia"]["mass"] * np.diff(padded, 2) / dt**2
+    return HistoryResult(
+        design,
+        dt * np.arange(x.size),
+        x,
+        scale * br.elastic,
+        scale * br.fractional,
+        scale * br.friction,
+        inertial,
+    )
