@@ -16,7 +16,6 @@ from core import Design
 from core.bushing import (
     MAX_STRAIN,
     branch_stiffness,
-    loop,
     material_model,
     stiffness,
     stiffness_points,
@@ -24,6 +23,7 @@ from core.bushing import (
 )
 from core.data import MeasuredLoop, MeasuredStiffness, loss_factor, magnitude_residual_pct
 from core.identify.fit import folded, gap
+from core.loops import loop
 from core.material import ConvergenceError
 
 from . import units

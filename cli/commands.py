@@ -18,9 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from core.bushing import MAX_SLICES, loop, slice_count, stiffness
+from core.bushing import MAX_SLICES, slice_count, stiffness
 from core.data import MAX_ROWS, DataError, csv_text
 from core.design import DesignError, read_design, read_design_file
+from core.loops import loop
 from core.material import ConvergenceError
 
 NUMBER_FORMAT = "{:.12g}"
