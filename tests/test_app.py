@@ -479,14 +479,14 @@ def test_only_changed_data_are_sent(app):
 def test_unchanged_elements_are_kept_as_they_were():
     import holoviews as hv
 
+    from app.elements import curve
     from app.live import reuse_unchanged
-    from app.plots import _curve
 
     x, y = hv.Dimension("x"), hv.Dimension("y")
-    a = _curve([1.0, np.nan], [2.0, 3.0], x, y, "a")
-    same = _curve([1.0, np.nan], [2.0, 3.0], x, y, "a")
-    other = _curve([1.0, np.nan], [2.0, 3.5], x, y, "a")
-    relabelled = _curve([1.0, np.nan], [2.0, 3.0], x, y, "b")
+    a = curve([1.0, np.nan], [2.0, 3.0], x, y, "a")
+    same = curve([1.0, np.nan], [2.0, 3.0], x, y, "a")
+    other = curve([1.0, np.nan], [2.0, 3.5], x, y, "a")
+    relabelled = curve([1.0, np.nan], [2.0, 3.0], x, y, "b")
     old = hv.Overlay([a, hv.VLine(1.0)])
     assert reuse_unchanged(old, hv.Overlay([same, hv.VLine(1.0)])) is old
     kept = reuse_unchanged(old, hv.Overlay([other, hv.VLine(1.0)]))
@@ -584,15 +584,15 @@ def test_changes_add_no_styles_and_no_options_entries(app):
     entry to HoloViews' options store (a session's memory stays flat however long it runs)."""
     import holoviews as hv
 
-    from app import plots
+    from app import elements
 
     app.state.shear_modulus_mpa = 2.5  # every style in use once
     app.state.amplitude = 0.3
-    templates, entries = plots._template.cache_info().currsize, len(hv.Store.custom_options())
+    templates, entries = elements.template.cache_info().currsize, len(hv.Store.custom_options())
     for i in range(15):
         app.state.shear_modulus_mpa = 2.0 + 0.01 * i
         app.state.amplitude = 0.05 + 0.01 * i
-    assert plots._template.cache_info().currsize == templates
+    assert elements.template.cache_info().currsize == templates
     assert len(hv.Store.custom_options()) == entries
 
 
