@@ -105,3 +105,7 @@ class ToleranceBands(param.Parameterized):
         except ToleranceError as exc:  # e.g. a sample outside the finite-length table
             self.band_message = str(exc)
             return None
+
+
+# what a band depends on: the inputs above, and the fit whose covariance it may use
+BAND_PARAMETERS = (*(n for n in ToleranceBands.param if n not in ("name", "band_message")), "fit_result")

@@ -12,8 +12,8 @@ from core.parameters import MODE, ROTATIONS, TRANSLATIONS
 from core.shape import long_shape_factor
 
 from . import plots, units
+from .bands import BAND_PARAMETERS
 from .curves import card_bands, card_sweeps, padded
-from .explorer import BAND_PARAMETERS
 from .inputs import FloatInput
 from .live import LivePlot
 from .state import ExplorerState
