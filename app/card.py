@@ -8,14 +8,16 @@ import panel as pn
 import param
 
 from core.card import card, card_design, ratios
+from core.parameters import MODE, ROTATIONS, TRANSLATIONS
 from core.shape import long_shape_factor
 
 from . import plots, units
+from .bands import BAND_PARAMETERS
 from .curves import card_bands, card_sweeps, padded
-from .explorer import BAND_PARAMETERS
 from .inputs import FloatInput
 from .live import LivePlot
 from .state import ExplorerState
+from .units import ROTATION, TRANSLATION
 from .views import PlotView
 
 WHICH = ("translation", "translation_loss", "rotation", "rotation_loss")
@@ -32,8 +34,9 @@ drive in each (at the same equivalent strain, the loss factors are the same: one
 class CardView(PlotView):
     """The bushing card at the operating frequency."""
 
-    displacement_mm = param.Number(0.1, bounds=(1e-6, 100.0), label="Displacement amplitude (mm)")
-    angle_rad = param.Number(0.01, bounds=(1e-7, 1.0), label="Angle amplitude (rad)")
+    displacement_mm = param.Number(0.1, bounds=(1e-6, 100.0),
+                                   label=f"Displacement amplitude ({TRANSLATION.amplitude.display})")
+    angle_rad = param.Number(0.01, bounds=(1e-7, 1.0), label=f"Angle amplitude ({ROTATION.amplitude.display})")
 
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
@@ -56,7 +59,8 @@ class CardView(PlotView):
 
     def _update(self):
         design, f = self.state.design, self.state.frequency_hz
-        x, angle = self.displacement_mm * 1e-3, self.angle_rad
+        x = float(TRANSLATION.amplitude.to_si(self.displacement_mm))  # m
+        angle = float(ROTATION.amplitude.to_si(self.angle_rad))  # rad
         try:
             rows = card(design, f, x, angle)
             data = card_sweeps(design, f)
@@ -66,10 +70,10 @@ class CardView(PlotView):
         for mode, b in (self.state.banded(lambda tol: card_bands(design, f, tol)) or {}).items():
             data[mode].update(b)
         self.table.object = self.summary(design, f, rows)
-        for which, modes in (("translation", ("axial", "radial")), ("rotation", ("torsion", "conical"))):
+        for which, modes in (("translation", TRANSLATIONS), ("rotation", ROTATIONS)):
             dim = self.dims["displacement" if which == "translation" else "angle"]
             dim.range = padded([data[m]["amplitude"] for m in modes], log=True)
-        at = {"translation": units.display_amplitude(x, "axial"), "rotation": units.display_amplitude(angle, "torsion")}
+        at = {"translation": TRANSLATION.amplitude.to_display(x), "rotation": ROTATION.amplitude.to_display(angle)}
         overlays = plots.card_overlays(data, self.dims, at)
         self.plots = LivePlot.shown(self.plots, [overlays[w] for w in WHICH])
 
@@ -83,7 +87,7 @@ class CardView(PlotView):
             mode = r["mode"]
             amp = units.display_amplitude(r["amplitude"], mode)
             k = units.display_stiffness(r["magnitude"], mode)
-            s_unit = "m" if mode in ("axial", "radial") else "m³"
+            s_unit = "m³" if MODE[mode].rotation else "m"
             try:
                 versus = f"{r['shape_factor'] / long_shape_factor(g.inner_radius, g.outer_radius, g.length, mode):.3f}"
             except ValueError:

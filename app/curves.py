@@ -19,12 +19,13 @@ from core.bushing import (
     material_model,
     stiffness,
     stiffness_points,
-    strain_factor,
 )
+from core.card import CARD_MODES, card_design
 from core.data import MeasuredLoop, MeasuredStiffness, loss_factor, magnitude_residual_pct
-from core.identify.fit import folded, gap
+from core.identify.fit import folded, gap, model_stiffness, selection
 from core.loops import loop
 from core.material import ConvergenceError
+from core.whatif.tolerance import band
 
 from . import units
 
@@ -37,15 +38,14 @@ def fletcher_gent_amplitudes(design: Design, n: int = 5, ratios=None) -> np.ndar
     """Drive amplitudes (display units) at equivalent strains ``ratios`` × ε½, by default ``n``
     log-spaced over the Fletcher–Gent range ε̂/ε½ = 1e-3 … 1e2."""
     z = np.geomspace(*units.FG_RANGE, n) if ratios is None else np.asarray(ratios, dtype=float)
-    c = strain_factor(design.geometry, design.mode, design.shape)
-    return units.display_amplitude(z * design.material.friction_strain_half / c, design.mode)
+    return units.display_amplitude(design.drive(z * design.material.friction_strain_half), design.mode)
 
 
 def amplitude_bounds(design: Design) -> tuple[float, float]:
     """The amplitude axis (display units): the Fletcher–Gent range, up to the largest strain the
     core computes (:data:`core.bushing.MAX_STRAIN`)."""
     x = fletcher_gent_amplitudes(design, 2)
-    top = units.display_amplitude(MAX_STRAIN / strain_factor(design.geometry, design.mode, design.shape), design.mode)
+    top = units.display_amplitude(design.drive(MAX_STRAIN), design.mode)
     return float(min(x[0], top / 10)), float(min(x[1], top))
 
 
@@ -100,19 +100,21 @@ def hysteresis_loop(design: Design, frequency_hz: float, amplitude: float, point
 def slice_comparison(design: Design, frequency_hz: float, amplitudes) -> dict:
     """|K| and loss factor against amplitude at one frequency for 1, 2, 3 slices and the
     continuum (Paper A), with the differences from the single modulus in %. A model whose
-    iteration does not converge is left out (never an unconverged number)."""
+    iteration does not converge is left out (never an unconverged number); one the core refuses
+    for this design too, with its reason in ``"refused"``."""
     x = np.asarray(amplitudes, dtype=float)
     out = {"amplitude": x, "magnitude": {}, "loss_factor": {}, "magnitude_diff_pct": {},
-           "loss_factor_diff_pct": {}}
+           "loss_factor_diff_pct": {}, "refused": None}
     model = material_model(design)
     for s in SLICES:
         try:
             r = stiffness(model, frequency_hz, units.to_si_amplitude(x, design.mode), slices=s)
         except ConvergenceError:
             continue
-        except ValueError:  # slices are derived for the long axial and torsion bushing only
+        except ValueError as exc:  # slices are derived for some designs only (core.bushing says which)
             if s == 1:
                 raise
+            out["refused"] = str(exc)
             continue
         out["magnitude"][s] = units.display_stiffness(r.magnitude[:, 0], design.mode)
         out["loss_factor"][s] = r.loss_factor[:, 0]
@@ -247,8 +249,6 @@ def operating_bands(design: Design, frequency_hz: float, amplitude: float, f, x,
     strain computes the friction branch once, an amplitude sweep the fractional branch once) and
     the point's. ``cache`` (a dict the caller keeps) holds the last few: moving the operating
     amplitude recomputes the frequency curve's band and the point's, not the amplitude curve's."""
-    from core.whatif.tolerance import band
-
     mode = design.mode
     a_si, x_si = float(units.to_si_amplitude(amplitude, mode)), units.to_si_amplitude(x, mode)
     f = np.asarray(f, dtype=float)
@@ -377,8 +377,6 @@ def card_sweeps(design: Design, frequency_hz: float, strains=None) -> dict:
 def card_bands(design: Design, frequency_hz: float, tolerances, strains=None) -> dict:
     """Each direction's tolerance band along :func:`card_sweeps`' curves: ``magnitude_band`` and
     ``loss_factor_band``, (low, high) at the first and last percentiles (display units)."""
-    from core.whatif.tolerance import band
-
     out = {}
     for mode, d, drive in _card_directions(design, _card_strains(strains)):
         b = band(d, frequency_hz, drive, tolerances)
@@ -394,18 +392,14 @@ def _card_strains(strains) -> np.ndarray:
 
 def _card_directions(design: Design, strains: np.ndarray):
     """(mode, the card's design in that direction, the drives at ``strains``) of every direction."""
-    from core.card import CARD_MODES, card_design
-
     for mode in CARD_MODES:
         d = card_design(material_model(design), mode)
-        yield mode, d, strains / strain_factor(d.geometry, mode, d.shape)
+        yield mode, d, d.drive(strains)
 
 
 def prediction_misfit(fit, measured: MeasuredStiffness | None) -> dict | None:
     """A fit on a subset (its ``prediction``) against every measured row: per mode, the |K|
     misfit (model − measured, %) against frequency of the fitted rows and of the predicted ones."""
-    from core.identify.fit import model_stiffness, selection
-
     if fit is None or not fit.prediction or measured is None:
         return None
     chosen = selection(measured, fit.design.mode, fit.prediction["fit_on"])

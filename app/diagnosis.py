@@ -14,9 +14,10 @@ from core.effects import EFFECTS
 from core.identify.diagnose import BIC_THRESHOLD
 from core.material import ConvergenceError
 
-from . import plots
 from .diagnosis_state import DiagnosisState
+from .elements import SWEEP_PALETTES, sweep_label
 from .live import LivePlot, update_or_keep
+from .misfit_plots import diagnosis_overlays
 from .units import amplitude_unit
 from .uploads import csv_dropper, on_upload
 
@@ -215,11 +216,11 @@ class DiagnosisView(pn.viewable.Viewer):
         return "\n\n".join(lines)
 
     def _draw(self, r):
-        overlays = plots.diagnosis_overlays(r)
-        palette = plots.SWEEP_PALETTES["amplitude"]
+        overlays = diagnosis_overlays(r)
+        palette = SWEEP_PALETTES["amplitude"]
         unit = amplitude_unit(r.final.design.mode)
         self.curve_key.object = "Amplitudes: " + " ".join(
-            f'<span style="color:{palette[i % len(palette)]};font-weight:bold">■ {plots.sweep_label(g["amplitude"], unit)}</span>'
+            f'<span style="color:{palette[i % len(palette)]};font-weight:bold">■ {sweep_label(g["amplitude"], unit)}</span>'
             for i, g in enumerate(overlays["groups"]))
         for name, cols in (("gap", 1), ("curves", 2), ("maps", 2)):
             live = self.live.get(name)

@@ -9,13 +9,11 @@ import panel as pn
 import param
 
 from . import plots
+from .bands import BAND_PARAMETERS
 from .live import LivePlot
 from .state import ExplorerState
 from .views import PlotView
 
-# what the tolerance bands depend on (app.state.ExplorerState.tolerances)
-BAND_PARAMETERS = ("tolerance_text", "band_on", "band_distribution", "band_samples", "band_seed", "band_from_fit",
-                   "fit_result")
 GRID = (("magnitude", "frequency"), ("magnitude", "amplitude"), ("loss_factor", "frequency"),
         ("loss_factor", "amplitude"))
 

@@ -10,8 +10,10 @@ import panel as pn
 from bokeh.models import CustomJSTickFormatter
 
 from core.bushing import STRUCTURAL_EFFECTS, shape_factor
+from core.parameters import DEFAULT_SHAPE
 
-from .state import DESIGN_FIELDS, ExplorerState
+from .fields import DESIGN_FIELDS, GEOMETRY_FIELDS, MATERIAL_FIELDS
+from .state import ExplorerState
 from .units import OPERATING_FREQUENCIES
 
 
@@ -152,13 +154,14 @@ class DesignInputs(pn.viewable.Viewer):
 
     def _shape_note(self):
         """How far the finite-length shape factor is from the long-bushing formula, for this
-        design (axial and radial; torsion's agree; conical has no formula)."""
-        self.finite_length.disabled = self.state.mode in ("radial", "conical")
+        design (axial and radial; torsion's agree; conical has no formula). The switch is off
+        where the mode always uses the finite-length one."""
+        self.finite_length.disabled = DEFAULT_SHAPE[self.state.mode] == "finite"
         self.shape_note.object = shape_comparison(self.state.design)
 
     def __panel__(self):
-        geometry = [self._field(n) for n in ("inner_radius_mm", "outer_radius_mm", "length_mm")]
-        material = [self._field(n) for n in list(DESIGN_FIELDS)[3:]]
+        geometry = [self._field(n) for n in GEOMETRY_FIELDS]
+        material = [self._field(n) for n in MATERIAL_FIELDS]
         return pn.Column(
             self.preset,
             self.mode,

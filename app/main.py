@@ -7,7 +7,8 @@ import os
 import sys
 
 import panel as pn
-import param
+
+from core.parameters import BY_NAME, GEOMETRY, MATERIAL, MODES, SHAPES
 
 from . import patches
 from .card import CardView
@@ -16,7 +17,7 @@ from .diagnosis_state import DiagnosisState
 from .explorer import CompareView, ExplorerPlots
 from .inputs import DesignInputs, status_banner
 from .measured import MeasuredView
-from .share import URL_NAMES, ExportView
+from .share import URL_NAMES, ExportView, ShareLink
 from .slices import SlicesView
 from .state import ExplorerState
 from .teaching import TeachingView
@@ -28,7 +29,18 @@ pn.extension("filedropper", throttled=False)  # the upload areas (app.uploads) a
 
 TITLE = "Bushing Explorer"
 
-ABOUT = """
+
+def _keys(names, last: str = ", ") -> str:
+    """```axial`, `torsion``: names in a sentence (the last two joined by ``last``)."""
+    quoted = [f"`{n}`" for n in names]
+    return last.join([", ".join(quoted[:-1]), quoted[-1]]) if len(quoted) > 1 else "".join(quoted)
+
+
+# the design file's material keys in Pa (µ, m, σ_fmax), and those without a unit (α, ε½)
+_DIMENSIONED = [n for n in MATERIAL if BY_NAME[n].unit.si != "–"]
+_PLAIN = [n for n in MATERIAL if BY_NAME[n].unit.si == "–"]
+
+ABOUT = f"""
 ### Bushing Explorer
 
 Dynamic stiffness of carbon-black-filled rubber bushings, axially, radially, in torsion and
@@ -59,10 +71,9 @@ the last two; only these two carry Re K < 0), then one row per point; amplitude 
 displacement in m (axial, radial) or angle in rad (torsion, conical), |K| in N/m or N·m/rad. A
 negative loss factor (a blocked stiffness above a wave resonance) is a measurement like any other. *Measured
 loop* (CSV): `time_s,displacement,force`, one or more periods of a steady harmonic test. *Design
-file* (JSON): `mode` (`axial`, `torsion`, `radial`, `conical`), optional `shape` (`long`,
-`finite`), `geometry` (`inner_radius`, `outer_radius`, `length` in m), `material`
-(`shear_modulus`, `fractional_coefficient` and `friction_stress_max` in Pa, `fractional_order`,
-`friction_strain_half`), optionally `name` and `effects`. A row or key that is missing, not a
+file* (JSON): `mode` ({_keys(MODES)}), optional `shape` ({_keys(SHAPES)}), `geometry`
+({_keys(GEOMETRY)} in m), `material` ({_keys(_DIMENSIONED, " and ")} in Pa,
+{_keys(_PLAIN)}), optionally `name` and `effects`. A row or key that is missing, not a
 number or out of range is refused with its line or key. The repository's `docs/` describe the
 model (with the thesis' equation numbers), every file and the `bushing` command line.
 """
@@ -76,25 +87,6 @@ UPLOAD_MESSAGE_BYTES = 16 * 1024 * 1024
 # SESSION_LIFETIME_S; the server looks every SESSION_CHECK_S
 SESSION_LIFETIME_S = 15
 SESSION_CHECK_S = 5
-
-
-class ShareLink(param.Parameterized):
-    """The design as the address bar shows it: the state's linked parameters, untouched by
-    validation (the state judges them). A link opened (or the browser's back button) applies
-    at once; the state's changes reach the address bar after a pause, so a slider drag is one
-    history entry and one URL write, not one per step."""
-
-    mode = param.Selector(objects=["axial", "torsion", "radial", "conical"], default="axial")
-    finite_length = param.Boolean(default=False)
-
-
-for _name in URL_NAMES:
-    if _name == "tolerance_text":
-        ShareLink.param.add_parameter(_name, param.String(default=""))
-    elif _name == "band_on":
-        ShareLink.param.add_parameter(_name, param.Boolean(default=False))
-    elif _name not in ("mode", "finite_length"):
-        ShareLink.param.add_parameter(_name, param.Number(default=None, allow_None=True))
 
 
 def flat(view: pn.viewable.Viewer) -> list:

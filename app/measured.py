@@ -13,9 +13,10 @@ import param
 
 from core import PAPER_B
 from core.identify.fit import PARAMETERS
+from core.parameters import BY_NAME
 from core.synthetic import paper_b_example
 
-from . import curves, plots
+from . import curves, misfit_plots
 from .curves import padded
 from .live import LivePlot
 from .state import ExplorerState
@@ -26,13 +27,8 @@ RESIDUALS = (("magnitude", "frequency"), ("loss", "frequency"), ("magnitude", "a
 
 log = logging.getLogger("bushing.app")
 
-LABELS = {
-    "shear_modulus": ("µ", 1e6, "MPa"),
-    "fractional_coefficient": ("m", 1e6, "MPa·s^α"),
-    "fractional_order": ("α", 1.0, ""),
-    "friction_stress_max": ("σ_fmax", 1e3, "kPa"),
-    "friction_strain_half": ("ε½", 1.0, ""),
-}
+FITTED = " and ".join([", ".join(BY_NAME[p].symbol for p in PARAMETERS[:-1]), BY_NAME[PARAMETERS[-1]].symbol])
+
 
 
 class MeasuredView(PlotView):
@@ -138,7 +134,7 @@ class MeasuredView(PlotView):
             self._prediction_key = key
             data = curves.prediction_misfit(r, s.measured)
             self.prediction.visible = data is not None
-            self.prediction.object = None if data is None else plots.prediction_overlay(data)
+            self.prediction.object = None if data is None else misfit_plots.prediction_overlay(data)
 
     def _draw(self, points, residuals):
         mode = self.state.design.mode
@@ -146,7 +142,7 @@ class MeasuredView(PlotView):
         if points is not None:  # plots of the same quantity share the axis: one range for both
             self.dims["residual_magnitude"].range = padded([residuals["magnitude_residual_pct"]])
             self.dims["residual_loss"].range = padded([residuals["loss_factor_residual"]])
-        overlays = plots.residual_overlays(points, residuals, self.dims)
+        overlays = misfit_plots.residual_overlays(points, residuals, self.dims)
         items = [overlays[k] for k in RESIDUALS]
         self.residuals = LivePlot.shown(self.residuals, items)
 
@@ -155,18 +151,18 @@ class MeasuredView(PlotView):
         vague = set(r.undetermined)
         rows = ["| parameter | fitted | ± standard error | 95 % interval (profile) |", "|---|---|---|---|"]
         for p in PARAMETERS:
-            sym, scale, unit = LABELS[p]
-            value, err = getattr(r.design.material, p) / scale, r.standard_errors[p] / scale
+            unit = BY_NAME[p].unit
+            value, err = unit.to_display(getattr(r.design.material, p)), unit.to_display(r.standard_errors[p])
             err = "–" if p in vague or not np.isfinite(err) else f"{err:.2g}"
-            ends = ["not bounded" if e is None else f"{e / scale:.3g}" for e in r.intervals.get(p, ())]
+            ends = ["not bounded" if e is None else f"{unit.to_display(e):.3g}" for e in r.intervals.get(p, ())]
             interval = " – ".join(ends) + (" **not determined**" if p in vague else "") or "–"
-            rows.append(f"| {sym} ({unit or '–'}) | {value:.5g} | {err} | {interval} |")
+            rows.append(f"| {BY_NAME[p].symbol} ({unit.display}) | {value:.5g} | {err} | {interval} |")
         gap = f"{r.gap:.4f}" if np.isfinite(r.gap) else "–"
         loop = f", loop RMS misfit {r.loop_rms:.4f}" if r.loop_rms is not None else ""
-        corr = ["| | " + " | ".join(LABELS[p][0] for p in PARAMETERS) + " |",
+        corr = ["| | " + " | ".join(BY_NAME[p].symbol for p in PARAMETERS) + " |",
                 "|---" * (len(PARAMETERS) + 1) + "|"]
         for a in PARAMETERS:
-            corr.append(f"| {LABELS[a][0]} | " + " | ".join(f"{r.correlation[a][b]:+.2f}" for b in PARAMETERS) + " |")
+            corr.append(f"| {BY_NAME[a].symbol} | " + " | ".join(f"{r.correlation[a][b]:+.2f}" for b in PARAMETERS) + " |")
         warnings = "".join(f"\n\n⚠ {w}" for w in r.warnings)
         by_mode = ("\n\nGap per mode: " + ", ".join(f"{m} **{g:.4f}**" for m, g in r.gap_by_mode.items())
                    if r.gap_by_mode else "")
@@ -188,7 +184,7 @@ class MeasuredView(PlotView):
                 "Load measured dynamic stiffness (and, if you have one, a quasi-static loop) as CSV "
                 "files (drop a file on its area or browse for it, up to 20 MB; the formats are in the About tab), or the "
                 "synthetic example. The points appear over the model in the Explorer tab; the "
-                "residuals are below. **Fit** identifies µ, m, α, σ_fmax and ε½ with standard "
+                f"residuals are below. **Fit** identifies {FITTED} with standard "
                 "errors and 95 % intervals, and says which parameters the data cannot determine; "
                 "then take the fitted design into the explorer or save it.",
                 sizing_mode="stretch_width"),

@@ -54,7 +54,7 @@ class SlicesView(PlotView):
                             f"| {de[ie]:+.2f} % at {xs[ie]:.3g} {unit} |")
         missing = [self.NAMES[s] for s in (2, 3, "continuum") if s not in data["magnitude"]]
         design = self.state.design
-        if design.mode not in ("axial", "torsion") or design.shape_kind != "long":
+        if data["refused"]:
             rows.append(f"\n_Slices and the continuum are derived for axial and torsion bushings with the "
                         f"long (closed-form) shape factors; this design is {design.mode} with the "
                         f"{design.shape_kind} shape: only the single modulus is shown._")

@@ -14,8 +14,8 @@ import math
 import numpy as np
 import param
 
-from core import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material
-from core.bushing import factors, stiffness, strain_factor
+from core import PAPER_B, TABLE_1, Design
+from core.bushing import stiffness
 from core.data import (
     DataError,
     MeasuredLoop,
@@ -24,81 +24,21 @@ from core.data import (
     parse_loop,
     parse_stiffness,
 )
-from core.design import SIZE_RANGE, as_dict
-from core.identify.fit import PARAMETERS as MATERIAL_PARAMETERS
 from core.identify.fit import FitResult, fit_global, fit_two_step, predicted, selection
-from core.whatif.tolerance import (
-    SAMPLES,
-    FitCovariance,
-    ToleranceError,
-    Tolerances,
-    band,
-    band_columns,
-)
+from core.parameters import MODE_TABLE, MODES
+from core.whatif.tolerance import band, band_columns
 
 from . import curves, units
+from .bands import ToleranceBands
+from .fields import DESIGN_FIELDS, DesignFields, design_from_fields, display_values
 from .units import FREQUENCY_BOUNDS
-
-# a parameter's key in the tolerances of a link (tol=mu:10,L:1)
-TOLERANCE_KEYS = {"inner_radius": "a", "outer_radius": "b", "length": "L", "shear_modulus": "mu",
-                  "fractional_coefficient": "m", "fractional_order": "alpha", "friction_stress_max": "sigma",
-                  "friction_strain_half": "eps_half"}
-_TOLERANCE_NAMES = {v: k for k, v in TOLERANCE_KEYS.items()}
-
-
-def parse_tolerances(text: str) -> dict[str, float]:
-    """``mu:10,L:1`` → {"shear_modulus": 10.0, "length": 1.0} (± %); ToleranceError if a key is
-    unknown, given twice or its value is not a number from 0 to 89."""
-    out: dict[str, float] = {}
-    for item in filter(None, (part.strip() for part in text.split(","))):
-        key, _, value = item.partition(":")
-        name = _TOLERANCE_NAMES.get(key.strip())
-        try:
-            number = float(value)
-        except ValueError:
-            number = math.nan
-        if name is None or name in out or not 0.0 <= number <= 89.0:
-            raise ToleranceError(f"the tolerances {text[:80]!r}: give key:percent pairs, keys from "
-                                 f"{', '.join(TOLERANCE_KEYS.values())}, percents from 0 to 89")
-        out[name] = number
-    return out
-
-# display parameter → (design key, factor from display unit to SI)
-GEOMETRY_FIELDS = {
-    "inner_radius_mm": ("inner_radius", 1e-3),
-    "outer_radius_mm": ("outer_radius", 1e-3),
-    "length_mm": ("length", 1e-3),
-}
-MATERIAL_FIELDS = {
-    "shear_modulus_mpa": ("shear_modulus", 1e6),
-    "fractional_coefficient_mpa": ("fractional_coefficient", 1e6),
-    "fractional_order": ("fractional_order", 1.0),
-    "friction_stress_max_kpa": ("friction_stress_max", 1e3),
-    "friction_strain_half": ("friction_strain_half", 1.0),
-}
-DESIGN_FIELDS = {**GEOMETRY_FIELDS, **MATERIAL_FIELDS}
-# design-error key → the display parameter to show the message beside
-ERROR_FIELD = {
-    **{f"geometry.{key}": name for name, (key, _) in GEOMETRY_FIELDS.items()},
-    **{f"material.{key}": name for name, (key, _) in MATERIAL_FIELDS.items()},
-}
 
 PRESETS = {"Paper B bushing (axial)": PAPER_B, "Table 1 bushing (torsion)": TABLE_1}
 
 
-
-def _display_values(design: Design) -> dict:
+def _shown_values(design: Design) -> dict:
     """The state parameters that show ``design``."""
-    values = {"mode": design.mode, "finite_length": design.shape == "finite"}
-    for name, (key, factor) in GEOMETRY_FIELDS.items():
-        values[name] = getattr(design.geometry, key) / factor
-    for name, (key, factor) in MATERIAL_FIELDS.items():
-        values[name] = getattr(design.material, key) / factor
-    return {k: float(f"{v:.12g}") if isinstance(v, float) else v for k, v in values.items()}
-
-
-def _number(doc, label, default, **kw):
-    return param.Number(default, allow_None=True, label=label, doc=doc, **kw)
+    return {"mode": design.mode, "finite_length": design.shape == "finite", **display_values(design)}
 
 
 def read_measured(parse, content: bytes | str, filename: str):
@@ -110,43 +50,45 @@ def read_measured(parse, content: bytes | str, filename: str):
         return None, f"{filename}: {exc}"
 
 
-class ExplorerState(param.Parameterized):
-    """One user's design session: inputs, the operating point, the pinned reference."""
+def _shape_doc() -> str:
+    """The shape switch's doc: the modes whose closed forms it switches, and the others."""
+    long, finite = ([m.name for m in MODE_TABLE if m.default_shape == k] for k in ("long", "finite"))
+    return (f"{' and '.join(long).capitalize()}: the thesis' closed forms (long bushing) or the finite-element "
+            f"shape factor of this length (torsion's are the same). {' and '.join(finite).capitalize()} always "
+            "use the finite-element one.")
+
+
+def _amplitude_doc() -> str:
+    """The drive amplitude's doc: each mode's drive with its unit."""
+    drives: dict[tuple[str, str], list[str]] = {}
+    for m in MODE_TABLE:
+        drives.setdefault((m.drive.lower(), m.amplitude.display), []).append(m.name)
+    words = [f"{drive} ({unit}: {', '.join(names)})" for (drive, unit), names in drives.items()]
+    return f"Peak {', '.join(words[:-1])} or {words[-1]} of the operating point."
+
+
+class ExplorerState(DesignFields, ToleranceBands):
+    """One user's design session: inputs (the design's fields, :class:`app.fields.DesignFields`),
+    the operating point, the pinned reference, measured data and the fit, the tolerance bands
+    (:class:`app.bands.ToleranceBands`)."""
 
     preset = param.Selector(
         objects=list(PRESETS), default=None, allow_None=True, label="Preset",
         doc="Load a bushing from the thesis: Paper B (axial) or Table 1 (torsion).",
     )
     mode = param.Selector(
-        objects=["axial", "torsion", "radial", "conical"], default="axial", label="Mode",
-        doc="Axial: the sleeves moved apart along the axis. Torsion: turned about it. Radial: moved "
-        "apart across it. Conical: tilted about a diameter.",
+        objects=list(MODES), default=PAPER_B.mode, label="Mode",
+        doc=" ".join(f"{m.name.capitalize()}: {m.description}." for m in MODE_TABLE),
     )
-    finite_length = param.Boolean(
-        False, label="Finite-length shape factor",
-        doc="Axial and torsion: the thesis' closed forms (long bushing) or the finite-element "
-        "shape factor of this length (torsion's are the same). Radial and conical always use "
-        "the finite-element one.",
-    )
-    inner_radius_mm = _number("Radius of the inner (bonded) sleeve.", "Inner radius a (mm)", 20.0)
-    outer_radius_mm = _number("Radius of the outer (bonded) sleeve; larger than a.", "Outer radius b (mm)", 35.0)
-    length_mm = _number("Axial length of the rubber.", "Length L (mm)", 90.0)
-    shear_modulus_mpa = _number("Elastic shear modulus µ: the stiffness that stays at any rate and amplitude.", "Shear modulus µ (MPa)", 2.42)
-    fractional_coefficient_mpa = _number("Fractional coefficient m: size of the frequency dependence.", "Fractional coefficient m (MPa·s^α)", 0.6)
-    fractional_order = _number("Fractional order α in (0, 1]: how fast stiffness rises with frequency.", "Fractional order α (–)", 0.2)
-    friction_stress_max_kpa = _number("Largest friction stress σ_fmax: size of the amplitude dependence.", "Friction stress σ_fmax (kPa)", 19.2)
-    friction_strain_half = _number("Strain ε½ at which half of σ_fmax is built: where the softening happens.", "Friction strain ε½ (–)", 4.0e-3)
+    finite_length = param.Boolean(False, label="Finite-length shape factor", doc=_shape_doc())
 
-    amplitude = param.Number(
-        0.1, bounds=(1e-12, None), label="Drive amplitude",
-        doc="Peak displacement (mm, axial) or peak angle (rad, torsion) of the operating point.",
-    )
+    amplitude = param.Number(0.1, bounds=(1e-12, None), label="Drive amplitude", doc=_amplitude_doc())
     frequency_hz = param.Number(
         10.0, bounds=FREQUENCY_BOUNDS, label="Loop frequency",
         doc="Frequency of the operating point: the hysteresis loop and the highlighted curves.",
     )
-    freq_min = _number("Lowest frequency of the sweeps.", "Sweep from (Hz)", 1.0)
-    freq_max = _number("Highest frequency of the sweeps.", "Sweep to (Hz)", 100.0)
+    freq_min = param.Number(1.0, allow_None=True, label="Sweep from (Hz)", doc="Lowest frequency of the sweeps.")
+    freq_max = param.Number(100.0, allow_None=True, label="Sweep to (Hz)", doc="Highest frequency of the sweeps.")
 
     design = param.ClassSelector(class_=Design, default=PAPER_B, doc="The last valid design (SI).")
     errors = param.Dict(default={}, doc="Input field → what is wrong with it.")
@@ -172,20 +114,6 @@ class ExplorerState(param.Parameterized):
                           "(SI), comma-separated, e.g. mode=axial,amplitude=1e-4: the fit uses those rows and "
                           "predicts the others, with the gap of each mode and amplitude.")
 
-    # ---- what-ifs: tolerance bands ---------------------------------------------------------------
-    tolerance_text = param.String(default="", doc="The tolerances in ± % as a link writes them (TOLERANCE_KEYS): "
-                                  "mu:10,L:1 is µ ±10 % and L ±1 %.")
-    band_on = param.Boolean(default=False, label="Show tolerance bands on the stiffness plots")
-    band_distribution = param.Selector(objects=["uniform", "normal"], default="uniform", label="Distribution",
-                                       doc="Uniform over ± the tolerance, or normal with the tolerance at 3σ "
-                                       "(truncated there).")
-    band_samples = param.Integer(default=SAMPLES, bounds=(10, 2000), label="Samples")
-    band_seed = param.Integer(default=0, bounds=(0, 2**31 - 1), label="Seed")
-    band_from_fit = param.Boolean(default=False, label="Material from the fit's covariance",
-                                  doc="Draw the five material parameters from the last fit's standard errors and "
-                                  "correlation (instead of their tolerances).")
-    band_message = param.String(default="", doc="Why no band is drawn, if one was asked for.")
-
     def __init__(self, **params):
         self._band_cache: dict = {}  # the last few tolerance bands (app.curves.operating_bands)
         self._loaded = []  # the last design loaded (a file, a fit): kept while the inputs show it
@@ -208,10 +136,10 @@ class ExplorerState(param.Parameterized):
         if names != {"mode"}:
             return
         old, new = events[0].old, events[0].new
-        geometry, shape = self.design.geometry, "finite" if self.finite_length else None
+        d, shape = self.design, "finite" if self.finite_length else None
         try:
-            eps = strain_factor(geometry, old, shape) * units.to_si_amplitude(self.amplitude, old)
-            x = units.display_amplitude(eps / strain_factor(geometry, new, shape), new)
+            eps = Design(old, d.geometry, d.material, shape=shape).strain(units.to_si_amplitude(self.amplitude, old))
+            x = units.display_amplitude(Design(new, d.geometry, d.material, shape=shape).drive(eps), new)
         except ValueError:  # a geometry outside the finite-length table: the validation says so
             return
         self.amplitude = float(f"{x:.3g}")
@@ -219,41 +147,13 @@ class ExplorerState(param.Parameterized):
     @param.depends(*DESIGN_FIELDS, "mode", "finite_length", "effects", "freq_min", "freq_max", watch=True,
                    on_init=False)
     def _validate(self):
-        errors = {}
-        values = {}
-        for name, (key, factor) in DESIGN_FIELDS.items():
-            v = getattr(self, name)
-            if v is None or not isinstance(v, (int, float)) or not math.isfinite(v):
-                errors[name] = "Enter a number."
-                continue
-            values[key] = v * factor
-            try:  # the core's own rule for this field alone (cross-field rules below)
-                if name in MATERIAL_FIELDS:
-                    Material(**{**as_dict(self.design.material), key: values[key]})
-                elif not SIZE_RANGE[0] <= values[key] <= SIZE_RANGE[1]:  # this field alone
-                    Geometry(**{**as_dict(self.design.geometry), key: values[key]})
-            except DesignError as exc:
-                errors[name] = _plain(exc)
-        if "inner_radius_mm" not in errors and "outer_radius_mm" not in errors:
-            try:  # b > a, whatever else is wrong
-                Geometry(values["inner_radius"], values["outer_radius"], self.design.geometry.length)
-            except DesignError as exc:
-                errors["outer_radius_mm"] = _plain(exc)
-        if not errors:
-            try:
-                geometry = Geometry(**{k: values[k] for k, _ in GEOMETRY_FIELDS.values()})
-                material = Material(**{k: values[k] for k, _ in MATERIAL_FIELDS.values()})
-                shape = "finite" if self.finite_length else None
-                design = Design(self.mode, geometry, material, effects=self.effects, shape=shape)
-                factors(design)  # the shape factor exists for this geometry (the FE table's range)
-            except DesignError as exc:
-                errors[ERROR_FIELD.get(exc.key, "mode")] = _plain(exc)
-            except ValueError as exc:  # outside the finite-length table: a geometry to change
-                errors["length_mm"] = f"{exc}."
-            else:
-                design = _match_shown(design, [*PRESETS.values(), *self._loaded])
-                if design != self.design:
-                    self.design = design
+        shape = "finite" if self.finite_length else None
+        fields = {name: getattr(self, name) for name in DESIGN_FIELDS}
+        design, errors = design_from_fields(fields, self.design, self.mode, shape, self.effects)
+        if design is not None:
+            design = _match_shown(design, [*PRESETS.values(), *self._loaded])
+            if design != self.design:
+                self.design = design
         fmin, fmax = self.freq_min, self.freq_max
         if fmin is None or not math.isfinite(fmin) or fmin <= 0:
             errors["freq_min"] = "Enter a positive frequency."
@@ -268,7 +168,7 @@ class ExplorerState(param.Parameterized):
         x_mid = self.fletcher_gent_amplitudes(design)[2]
         self._loaded = [design]
         self.param.update(
-            **_display_values(design),
+            **_shown_values(design),
             effects=design.portable_effects,  # a rig's mass stays with its mode
             amplitude=float(f"{x_mid:.3g}"),
         )
@@ -482,57 +382,6 @@ class ExplorerState(param.Parameterized):
     def operating_point(self, design: Design | None = None) -> dict:
         return curves.operating_point(design or self.design, self.frequency_hz, self.amplitude)
 
-    @property
-    def tolerance_pct(self) -> dict[str, float]:
-        """The tolerances by parameter (core names), ± %. Raises ToleranceError for a text (a
-        link's) that is not a list of known parameters with numbers."""
-        return parse_tolerances(self.tolerance_text)
-
-    @tolerance_pct.setter
-    def tolerance_pct(self, values: dict[str, float]):
-        self.tolerance_text = ",".join(f"{TOLERANCE_KEYS[n]}:{v:g}" for n, v in values.items() if v)
-
-    def tolerances(self) -> Tolerances | None:
-        """The tolerances the bands are drawn with (:class:`core.whatif.tolerance.Tolerances`), None
-        when bands are off or nothing varies. Raises ToleranceError with the reason."""
-        if not self.band_on:
-            return None
-        material = set(MATERIAL_PARAMETERS) if self.band_from_fit else set()
-        relative = {n: v / 100.0 for n, v in self.tolerance_pct.items() if v and n not in material}
-        covariance = None
-        if self.band_from_fit:
-            if self.fit_result is None:
-                raise ToleranceError("no fit yet: fit measured data first (Measured data and fit), or use tolerances")
-            covariance = FitCovariance.of(self.fit_result)
-        tol = Tolerances(relative, distribution=self.band_distribution, samples=self.band_samples, seed=self.band_seed,
-                         covariance=covariance)
-        if not tol.varied:
-            raise ToleranceError("every tolerance is 0: give one (± %) to see a band")
-        return tol
-
-    def checked_tolerances(self) -> Tolerances | None:
-        """:meth:`tolerances`, or None with the reason in :attr:`band_message` (a band computed
-        with them may still say why it cannot be: :meth:`banded`)."""
-        try:
-            tol = self.tolerances()
-        except ToleranceError as exc:
-            self.band_message = str(exc)
-            return None
-        self.band_message = ""
-        return tol
-
-    def banded(self, compute):
-        """``compute(tolerances)`` with the tolerances of the bands, or None when there are none
-        or a sample cannot be computed (the reason in :attr:`band_message`)."""
-        tolerances = self.checked_tolerances()
-        if tolerances is None:
-            return None
-        try:
-            return compute(tolerances)
-        except ToleranceError as exc:  # e.g. a sample outside the finite-length table
-            self.band_message = str(exc)
-            return None
-
     def explorer_data(self):
         """Everything the explorer's five plots show (:func:`app.curves.explorer_data`)."""
         bands = self.banded(lambda tol: curves.operating_bands(
@@ -585,23 +434,8 @@ class ExplorerState(param.Parameterized):
 def _match_shown(design: Design, known) -> Design:
     """A known design itself (exact SI values, its name) when the inputs show it: a preset, or
     the design last loaded from a file or a fit."""
-    shown = _display_values(design)
+    shown = _shown_values(design)
     for candidate in known:
-        if _display_values(candidate) == shown and candidate.effects == design.effects:
+        if _shown_values(candidate) == shown and candidate.effects == design.effects:
             return candidate
     return design
-
-
-def _plain(exc: DesignError) -> str:
-    """A design error in the words of the input panel (mm, MPa) rather than the file's keys."""
-    rule = exc.rule
-    for name, (key, _) in DESIGN_FIELDS.items():
-        rule = rule.replace(f"geometry.{key}", name).replace(f"material.{key}", name)
-    rule = rule.replace("outer_radius_mm", "b").replace("inner_radius_mm", "a")
-    if "b > a" in rule:
-        return "Must be larger than the inner radius a."
-    if "must be positive" in rule:
-        return "Must be positive."
-    if "(0, 1]" in rule:
-        return "Must lie in (0, 1]."
-    return rule[0].upper() + rule[1:]

@@ -7,7 +7,7 @@ import numpy as np
 import panel as pn
 import param
 
-from . import plots
+from .elements import dimensions
 from .live import update_or_keep
 from .state import ExplorerState
 from .units import OPERATING_FREQUENCIES
@@ -27,10 +27,10 @@ class PlotView(pn.viewable.Viewer):
         super().__init__(state=state, **params)
 
     def dims_for(self, mode: str) -> dict:
-        """The view's dimensions (:func:`app.plots.dimensions`): kept while the mode is, so that
+        """The view's dimensions (:func:`app.elements.dimensions`): kept while the mode is, so that
         the ranges set on them are the plots'; new with new units."""
         if mode != self._mode:
-            self.dims, self._mode = plots.dimensions(mode), mode
+            self.dims, self._mode = dimensions(mode), mode
         return self.dims
 
     def changed(self):

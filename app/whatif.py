@@ -12,11 +12,13 @@ import holoviews as hv
 import panel as pn
 import param
 
+from core.parameters import BY_NAME, GEOMETRY, TRANSLATIONS
 from core.whatif.sensitivity import SENSITIVITY_PARAMETERS, SYMBOLS, elasticities, ranked, sentence
 from core.whatif.target import Found, TargetError, problem_from_dict, solve
 from core.whatif.tolerance import ToleranceError
 
 from . import plots, units
+from .fields import value_of
 from .inputs import FloatInput, IntInput
 from .live import LivePlot
 from .state import ExplorerState
@@ -24,10 +26,9 @@ from .views import PlotView
 
 log = logging.getLogger("bushing.app")
 
-NAMES = {"inner_radius": "Inner radius a", "outer_radius": "Outer radius b", "length": "Length L",
-         "shear_modulus": "Shear modulus µ", "fractional_coefficient": "Fractional coefficient m",
-         "fractional_order": "Fractional order α", "friction_stress_max": "Friction stress σ_fmax",
-         "friction_strain_half": "Friction strain ε½"}
+A, B, L, MU = (BY_NAME[n] for n in ("inner_radius", "outer_radius", "length", "shear_modulus"))
+# a found design's columns: its geometry and µ (what a search changes), each to its digits
+FOUND_COLUMNS = {**{n: ".3f" for n in GEOMETRY}, L.name: ".2f", MU.name: ".4g"}
 
 TOLERANCE_TEXT = """
 **Tolerance bands.** Give each parameter's tolerance (± % of its value) and switch the bands on:
@@ -58,12 +59,17 @@ class WhatIfView(PlotView):
     target_tolerance_pct = param.Number(default=1.0, bounds=(0.001, 50.0), label="Met within ± %")
     loss_factor_min = param.Number(default=None, allow_None=True, bounds=(0, 10), label="Loss factor at least")
     ratio_min = param.Number(default=None, allow_None=True, bounds=(0, None), label="Radial / axial at least")
-    b_max_mm = param.Number(default=None, allow_None=True, bounds=(0, None), label="b at most (mm)")
-    length_max_mm = param.Number(default=None, allow_None=True, bounds=(0, None), label="L at most (mm)")
-    thickness_min_mm = param.Number(default=2.0, allow_None=True, bounds=(0, None), label="Rubber b − a at least (mm)")
+    b_max_mm = param.Number(default=None, allow_None=True, bounds=(0, None),
+                            label=f"{B.symbol} at most ({B.unit.display})")
+    length_max_mm = param.Number(default=None, allow_None=True, bounds=(0, None),
+                                 label=f"{L.symbol} at most ({L.unit.display})")
+    thickness_min_mm = param.Number(default=2.0, allow_None=True, bounds=(0, None),
+                                    label=f"Rubber {B.symbol} − {A.symbol} at least ({B.unit.display})")
     hold_inner = param.Boolean(default=True, label="Keep the inner radius (the shaft)")
-    mu_min_mpa = param.Number(default=None, allow_None=True, bounds=(0, None), label="µ from (MPa)")
-    mu_max_mpa = param.Number(default=None, allow_None=True, bounds=(0, None), label="µ to (MPa)")
+    mu_min_mpa = param.Number(default=None, allow_None=True, bounds=(0, None),
+                              label=f"{MU.symbol} from ({MU.unit.display})")
+    mu_max_mpa = param.Number(default=None, allow_None=True, bounds=(0, None),
+                              label=f"{MU.symbol} to ({MU.unit.display})")
     running = param.Boolean(default=False)
     found = param.Parameter(default=None, doc="The last search's core.whatif.target.Found.")
     message = param.String(default="")
@@ -72,7 +78,7 @@ class WhatIfView(PlotView):
         self._showing = False
         super().__init__(state, **params)
         self.tolerance_inputs = {
-            n: FloatInput(label=f"{NAMES[n]} ± %", value=self._shown_tolerances().get(n, 0.0), start=0.0,
+            n: FloatInput(label=f"{BY_NAME[n].label} ± %", value=self._shown_tolerances().get(n, 0.0), start=0.0,
                                      end=89.0, step=0.5, width=170)
             for n in SENSITIVITY_PARAMETERS}
         for name, widget in self.tolerance_inputs.items():
@@ -180,22 +186,22 @@ class WhatIfView(PlotView):
         if self.loss_factor_min:
             targets.append({"mode": mode, "frequency_hz": f, "amplitude": x, "loss_factor": {"min": self.loss_factor_min}})
         if self.ratio_min:
-            drive = x if mode in ("axial", "radial") else 1e-4  # a translation's drive: the operating one, or 0.1 mm
+            drive = x if mode in TRANSLATIONS else 1e-4  # a translation's drive: the operating one, or 0.1 mm
             targets.append({"ratio": ["radial", "axial"], "frequency_hz": f, "amplitude": drive,
                             "magnitude": {"min": self.ratio_min}})
         limits = {}
         if self.b_max_mm:
-            limits["outer_radius"] = {"max": self.b_max_mm * 1e-3}
+            limits["outer_radius"] = {"max": float(B.unit.to_si(self.b_max_mm))}
         if self.length_max_mm:
-            limits["length"] = {"max": self.length_max_mm * 1e-3}
+            limits["length"] = {"max": float(L.unit.to_si(self.length_max_mm))}
         if self.thickness_min_mm:
-            limits["thickness"] = {"min": self.thickness_min_mm * 1e-3}
+            limits["thickness"] = {"min": float(B.unit.to_si(self.thickness_min_mm))}
         out = {"design": design.to_dict(), "targets": targets, "limits": limits, "solutions": 5}
         if self.hold_inner:
             out["fixed"] = ["inner_radius"]
         if self.mu_min_mpa or self.mu_max_mpa:
-            out["free_material"] = {"shear_modulus": {k: v * 1e6 for k, v in (("min", self.mu_min_mpa),
-                                                                              ("max", self.mu_max_mpa)) if v}}
+            out["free_material"] = {MU.name: {k: float(MU.unit.to_si(v)) for k, v in (("min", self.mu_min_mpa),
+                                                                                  ("max", self.mu_max_mpa)) if v}}
         return out
 
     def _targets_file(self):
@@ -245,21 +251,18 @@ class WhatIfView(PlotView):
         rows = found.solutions or ([found.closest] if found.closest is not None else [])
         if rows:
             targets = found.problem.targets
-            lines += ["", "| | a (mm) | b (mm) | L (mm) | µ (MPa) | " +
-                      " | ".join(f"target {j}" for j in range(1, len(targets) + 1)) + " |",
-                      "|---" * (5 + len(targets)) + "|"]
+            header = [f"{BY_NAME[n].symbol} ({BY_NAME[n].unit.display})" for n in FOUND_COLUMNS]
+            lines += ["", "| | " + " | ".join(header + [f"target {j}" for j in range(1, len(targets) + 1)]) + " |",
+                      "|---" * (1 + len(header) + len(targets)) + "|"]
             for i, sol in enumerate(rows, 1):
-                g, m = sol.design.geometry, sol.design.material
                 got = " | ".join(f"{units.display_stiffness(v, mode):.4g} {units.stiffness_unit(mode)}"
                                  if t.quantity == "magnitude" and not t.is_ratio else f"{v:.4g}"
                                  for t, v in zip(targets, sol.achieved))
                 name = f"{i}" if found.solutions else "closest"
-                lines.append(f"| {name} | {g.inner_radius * 1e3:.3f} | {g.outer_radius * 1e3:.3f} | "
-                             f"{g.length * 1e3:.2f} | {m.shear_modulus / 1e6:.4g} | {got} |")
+                lines.append(f"| {name} | {found_values(sol.design, ' | ')} | {got} |")
             lines += [""] + [f"Target {j}: {t.describe()} (SI units)." for j, t in enumerate(targets, 1)]
         self.result.object = "\n".join(lines)
-        self.solutions.options = {f"{i}: a {s.design.geometry.inner_radius * 1e3:.3f}, b "
-                                  f"{s.design.geometry.outer_radius * 1e3:.3f}, L {s.design.geometry.length * 1e3:.2f} mm": i - 1
+        self.solutions.options = {f"{i}: {found_values(s.design, ', ', GEOMETRY, symbols=True)} {A.unit.display}": i - 1
                                   for i, s in enumerate(rows, 1)}
         self.solutions.visible = self.use.visible = bool(rows)
         self.use.label = "Take it into the explorer" if found.solutions else "Take the closest into the explorer"
@@ -294,3 +297,14 @@ class WhatIfView(PlotView):
             pn.pane.Markdown(DESIGN_TEXT, sizing_mode="stretch_width"), form,
             sizing_mode="stretch_width")
 
+
+
+def found_values(design, sep: str, names=tuple(FOUND_COLUMNS), symbols: bool = False) -> str:
+    """A found design's values of ``names`` in display units, each to its digits
+    (:data:`FOUND_COLUMNS`), joined by ``sep``; each after its symbol with ``symbols``."""
+    cells = []
+    for n in names:
+        p = BY_NAME[n]
+        text = f"{p.unit.to_display(value_of(design, p)):{FOUND_COLUMNS[n]}}"
+        cells.append(f"{p.symbol} {text}" if symbols else text)
+    return sep.join(cells)

@@ -119,7 +119,7 @@ def test_the_design_form_says_when_targets_cannot_be_met(app):
 
 
 def test_tolerances_travel_in_a_link(app):
-    from app.state import parse_tolerances
+    from app.bands import parse_tolerances
     from core.whatif.tolerance import ToleranceError
 
     assert parse_tolerances("mu:10, L:0.5") == {"shear_modulus": 10.0, "length": 0.5}

@@ -1,0 +1,190 @@
+"""The elements every plot is made of: the plotted quantities' dimensions, and HoloViews curves,
+points, areas, markers and overlays, each a clone of a styled template.
+
+Each element is a clone of a styled template (:func:`styled`): the options are attached once,
+and a clone carries them, so a live plot that rebuilds its elements on every change does not
+re-resolve its options. The figures are built from them in :mod:`app.plots` (the public
+plotting API) and :mod:`app.misfit_plots` (model against measured data).
+"""
+
+from __future__ import annotations
+
+import functools
+
+import holoviews as hv
+import holoviews.plotting.bokeh
+import numpy as np
+from bokeh.models import SaveTool
+
+from core.parameters import MODES
+from core.parameters import mode as mode_of
+
+# Without a GPU, Chromium draws WebGL through SwiftShader on the CPU: measured in the explorer,
+# the GPU process then spent about 110 ms per update (7 ms with canvas). HoloViews 1.23 asks for
+# WebGL by default; these plots are small (at most a few thousand points), canvas is the right
+# backend for them everywhere.
+hv.renderer("bokeh").webgl = False
+
+OPERATING_COLOR = "#e6550d"
+# one colour per mode (the card, the fit's predicted rows)
+MODE_COLORS = dict(zip(MODES, ("#1f77b4", "#2ca02c", "#d62728", "#9467bd")))
+SWEEP_PALETTES = {  # light to dark as the swept value grows
+    "amplitude": ["#9ecae1", "#6baed6", "#3182bd", "#08519c", "#08306b"],
+    "frequency": ["#a1d99b", "#41ab5d", "#006d2c", "#00441b", "#002910"],
+}
+
+
+def sweep_label(value, unit) -> str:
+    return f"{value:.3g} {unit}"
+
+
+# ---- dimensions --------------------------------------------------------------------------------
+
+
+def dimensions(mode: str) -> dict[str, hv.Dimension]:
+    """The plotted quantities of ``mode`` with their names, labels and units (the display units
+    of :mod:`core.parameters`)."""
+    m = mode_of(mode)
+    amp, stiff, force = m.amplitude.display, m.stiffness.display, m.force.display
+    return {
+        "frequency": hv.Dimension("frequency_hz", label="Frequency", unit="Hz"),
+        "amplitude": hv.Dimension("amplitude", label="Amplitude", unit=amp),
+        "magnitude": hv.Dimension("magnitude", label="|K|", unit=stiff),
+        "loss_factor": hv.Dimension("loss_factor", label="Loss factor"),
+        "displacement": hv.Dimension("displacement", label=m.drive, unit=amp),
+        "force": hv.Dimension("force", label=m.load, unit=force),
+        "difference": hv.Dimension("difference", label="Difference", unit="%"),
+        "real": hv.Dimension("real", label="Re K", unit=stiff),
+        "branch_loss": hv.Dimension("branch_loss", label="Loss factor"),
+        "drive_rel": hv.Dimension("drive_rel", label="Drive / peak drive"),
+        "force_rel": hv.Dimension("force_rel", label="Force / peak force"),
+        "residual_magnitude": hv.Dimension("residual_magnitude", label="|K| residual", unit="%"),
+        "residual_loss": hv.Dimension("residual_loss", label="Loss-factor residual"),
+        "stage": hv.Dimension("stage", label="Step"),
+        "gap": hv.Dimension("gap", label="Gap"),
+        "misfit_magnitude": hv.Dimension("misfit_magnitude", label="|K| misfit", unit="%"),
+        "misfit_loss": hv.Dimension("misfit_loss", label="Loss-factor misfit"),
+    }
+
+
+# ---- styled templates ----------------------------------------------------------------------------
+
+
+def legend_outside(plot, _element):
+    """A hook that puts the plot's legend to the right of the frame, once.
+
+    Why not ``legend_position="right"``: with a legend outside the frame, HoloViews 1.23 removes
+    it from the plot and adds it again on every update (``OverlayPlot._process_legend``), which
+    changes the plot's layout lists: the browser lays the plot out again and the server walks
+    every model of the document (measured: about a third of the server's time per change, and
+    most of Chromium's). Placed here once, HoloViews finds the legend where it is and leaves it."""
+    fig = plot.state
+    for legend in list(fig.center):
+        if legend.__class__.__name__ == "Legend":
+            fig.center.remove(legend)
+            fig.add_layout(legend, "right")
+
+
+@functools.cache
+def png_name(name: str):
+    """A hook naming the PNG that a plot's save tool writes (one function per name: the hooks
+    are part of a template's key, see :func:`styled`)."""
+
+    def hook(plot, _element):
+        for tool in plot.state.toolbar.tools:  # not state.select: that walks every model (measured: 9 ms)
+            if isinstance(tool, SaveTool) and tool.filename != name:
+                tool.filename = name
+
+    hook.__name__ = f"png_{name}"
+    return hook
+
+
+@functools.cache
+def template(kind: str, key: tuple) -> hv.Element | hv.Overlay:
+    element = {"Curve": hv.Curve, "Scatter": hv.Scatter, "Area": hv.Area, "VLine": hv.VLine,
+               "HLine": hv.HLine, "Bars": hv.Bars, "Points": hv.Points, "Overlay": hv.Overlay}[kind]
+    empty = 0.0 if kind in ("VLine", "HLine") else []
+    return element(empty).opts(**{k: _thaw(v) for k, v in key})
+
+
+def _freeze(value):
+    """A hashable form of an option value (dicts and lists tagged, to be thawed back)."""
+    if isinstance(value, dict):
+        return ("<dict>", tuple(sorted((k, _freeze(v)) for k, v in value.items())))
+    if isinstance(value, list):
+        return ("<list>", tuple(_freeze(v) for v in value))
+    return value
+
+
+def _thaw(value):
+    if isinstance(value, tuple) and len(value) == 2 and value[0] in ("<dict>", "<list>"):
+        if value[0] == "<dict>":
+            return {k: _thaw(v) for k, v in value[1]}
+        return [_thaw(v) for v in value[1]]
+    return value
+
+
+def styled(kind: str, data, **options):
+    """An element of ``kind`` holding ``data``, cloned from a template that carries ``options``
+    (one options entry per style, whatever the number of frames)."""
+    options.setdefault("framewise", True)  # a norm option of each element: its axes follow its data
+    if kind in ("Curve", "Scatter", "Area"):
+        # a click on a legend entry mutes its glyph, drawn fully transparent: hidden. HoloViews
+        # keeps a glyph muted through updates (it shows a hidden one again on every frame)
+        options.setdefault("muted_alpha", 0.0)
+    key = tuple(sorted((k, _freeze(v)) for k, v in options.items() if k not in ("kdims", "vdims", "label")))
+    fields = {k: options[k] for k in ("kdims", "vdims", "label") if k in options}
+    return template(kind, key).clone(data, **fields)
+
+
+def curve(x, y, xdim, ydim, label, **style):
+    style.setdefault("tools", ["hover"])
+    return styled("Curve", (np.asarray(x, dtype=float), np.asarray(y, dtype=float)),
+                  kdims=[xdim], vdims=[ydim], label=label, **style)
+
+
+def scatter(x, y, xdim, ydim, label, **style):
+    style.setdefault("tools", ["hover"])
+    return styled("Scatter", (np.asarray(x, dtype=float), np.asarray(y, dtype=float)),
+                  kdims=[xdim], vdims=[ydim], label=label, **style)
+
+
+def overlay(items, title, png, *, logx=False, logy=False, legend="right", height=300):
+    legend_opts = {"click_policy": "mute", "label_text_font_size": "11px", "spacing": 0, "padding": 4,
+                   "margin": 4}
+    hooks = [png_name(png)] + ([legend_outside] if legend == "right" else [])
+    options = {"title": title, "responsive": True, "height": height, "logx": logx, "logy": logy,
+               "framewise": True, "hooks": hooks, "legend_opts": legend_opts,
+               "fontsize": {"title": "13px"}, "show_legend": legend is not None}
+    if legend is not None:
+        options["legend_position"] = "top_right" if legend == "right" else legend
+    return styled("Overlay", list(items), **options)
+
+
+def band_area(x, low, high, xdim: hv.Dimension, ydim: hv.Dimension, label: str, color: str):
+    """A tolerance band: the area between ``low`` and ``high``."""
+    # its own label: HoloViews finds a dimension by its label, and two alike would both read the lower
+    upper = hv.Dimension(f"{ydim.name}_upper", label=f"{ydim.label} (band top)", unit=ydim.unit)
+    return styled("Area", (np.asarray(x, dtype=float), np.asarray(low, dtype=float), np.asarray(high, dtype=float)),
+                  kdims=[xdim], vdims=[ydim, upper], label=label, color=color, fill_alpha=0.22, line_alpha=0.0,
+                  tools=["hover"])
+
+
+def band_label(percentiles) -> str:
+    low, high = percentiles
+    return f"{low:g}–{high:g} % band"
+
+
+def marker(x: float, dim: hv.Dimension):
+    """The operating point: a dotted vertical line at ``x``."""
+    return styled("VLine", float(x), kdims=[dim, hv.Dimension("y")], color=OPERATING_COLOR,
+                  line_dash="dotted", line_width=1.5)
+
+
+def sized(layout: hv.Layout, width: int | None) -> hv.Layout:
+    """``layout`` with plots ``width`` pixels wide (for a notebook or a saved file), or as they
+    are (filling the width of their container) for None."""
+    if width is None:
+        return layout
+    return layout.map(lambda plot: plot.opts(responsive=False, width=width), [hv.Overlay])
+

@@ -1,0 +1,103 @@
+"""The explorer's design fields, made from the one table (:mod:`core.parameters`).
+
+One number per design parameter, in its display unit (``shear_modulus_mpa``: µ in MPa), labelled
+and documented as the table says; a design shown in them; and the design they give, or what is
+wrong with each field in the words of the input panel. No Panel import.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import param
+
+from core import PAPER_B, Design, DesignError, Geometry, Material
+from core.bushing import factors
+from core.design import SIZE_RANGE, as_dict
+from core.parameters import BY_NAME, GEOMETRY, MATERIAL, PARAMETERS, DesignParameter
+
+# field name → its design parameter, in the table's order (geometry, then material)
+DESIGN_FIELDS: dict[str, DesignParameter] = {p.field: p for p in PARAMETERS}
+GEOMETRY_FIELDS = tuple(BY_NAME[n].field for n in GEOMETRY)
+MATERIAL_FIELDS = tuple(BY_NAME[n].field for n in MATERIAL)
+# design-error key → the field to show the message beside
+ERROR_FIELD = {f"{p.group}.{p.name}": p.field for p in PARAMETERS}
+# the fields named by the rule b > a, and by a geometry outside the finite-length table
+_INNER, _OUTER, _LENGTH = BY_NAME["inner_radius"].field, BY_NAME["outer_radius"].field, BY_NAME["length"].field
+
+
+def value_of(design: Design, p: DesignParameter) -> float:
+    """The value of parameter ``p`` in ``design`` (SI)."""
+    return getattr(getattr(design, p.group), p.name)
+
+
+def display_values(design: Design) -> dict[str, float]:
+    """The fields that show ``design`` (display units, to 12 digits: no 19.200000000000003)."""
+    return {name: float(f"{p.unit.to_display(value_of(design, p)):.12g}") for name, p in DESIGN_FIELDS.items()}
+
+
+def _field(p: DesignParameter, default: float) -> param.Number:
+    return param.Number(default, allow_None=True, label=p.display_label, doc=p.doc)
+
+
+_FIRST = display_values(PAPER_B)  # the fields show the Paper B bushing at first
+DesignFields = type("DesignFields", (param.Parameterized,), {
+    "__doc__": "The design's fields (display units), one param.Number per parameter of core.parameters.",
+    **{name: _field(p, _FIRST[name]) for name, p in DESIGN_FIELDS.items()},
+})
+
+
+def design_from_fields(fields: Mapping, shown: Design, mode: str, shape: str | None,
+                       effects) -> tuple[Design | None, dict[str, str]]:
+    """The design that ``fields`` (field name → value in display units) give in ``mode`` with
+    ``shape`` and ``effects``, and ``{}``; or None and, field by field, what is wrong. The core's
+    rules judge: a field alone against the values of ``shown`` (the design shown last), b > a
+    whatever else is wrong, then the whole design (its shape factor must exist)."""
+    errors: dict[str, str] = {}
+    values: dict[str, float] = {}
+    for name, p in DESIGN_FIELDS.items():
+        v = fields[name]
+        if v is None or not isinstance(v, (int, float)) or not math.isfinite(v):
+            errors[name] = "Enter a number."
+            continue
+        values[p.name] = float(p.unit.to_si(v))
+        try:  # the core's own rule for this field alone (cross-field rules below)
+            if p.group == "material":
+                Material(**{**as_dict(shown.material), p.name: values[p.name]})
+            elif not SIZE_RANGE[0] <= values[p.name] <= SIZE_RANGE[1]:  # this field alone
+                Geometry(**{**as_dict(shown.geometry), p.name: values[p.name]})
+        except DesignError as exc:
+            errors[name] = _plain(exc)
+    if _INNER not in errors and _OUTER not in errors:
+        try:  # b > a, whatever else is wrong
+            Geometry(values["inner_radius"], values["outer_radius"], shown.geometry.length)
+        except DesignError as exc:
+            errors[_OUTER] = _plain(exc)
+    if errors:
+        return None, errors
+    try:
+        geometry = Geometry(**{n: values[n] for n in GEOMETRY})
+        material = Material(**{n: values[n] for n in MATERIAL})
+        design = Design(mode, geometry, material, effects=effects, shape=shape)
+        factors(design)  # the shape factor exists for this geometry (the FE table's range)
+    except DesignError as exc:
+        return None, {ERROR_FIELD.get(exc.key, "mode"): _plain(exc)}
+    except ValueError as exc:  # outside the finite-length table: a geometry to change
+        return None, {_LENGTH: f"{exc}."}
+    return design, {}
+
+
+def _plain(exc: DesignError) -> str:
+    """A design error in the words of the input panel (mm, MPa) rather than the file's keys."""
+    rule = exc.rule
+    for name, key in ((p.field, p.name) for p in PARAMETERS):
+        rule = rule.replace(f"geometry.{key}", name).replace(f"material.{key}", name)
+    rule = rule.replace("outer_radius_mm", "b").replace("inner_radius_mm", "a")
+    if "b > a" in rule:
+        return "Must be larger than the inner radius a."
+    if "must be positive" in rule:
+        return "Must be positive."
+    if "(0, 1]" in rule:
+        return "Must lie in (0, 1]."
+    return rule[0].upper() + rule[1:]

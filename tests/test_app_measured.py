@@ -1,0 +1,149 @@
+"""The explorer's measured-data tab without a browser: files loaded, drawn over the model and
+refused with their reasons; the fits in the session against the core's."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from app.main import App
+from core import PAPER_B, loads_design, stiffness_points
+from tests.helpers import xy
+
+
+@pytest.fixture
+def app():
+    return App()
+
+
+def example_files():
+    from core.synthetic import paper_b_example
+
+    data, loop = paper_b_example(PAPER_B)
+    return data.to_csv().encode(), loop.to_csv().encode()
+
+
+def test_measured_points_appear_over_the_model(app):
+    stiff, loop_bytes = example_files()
+    app.inputs.widgets["shear_modulus_mpa"].value = 2.0  # a design that misses the data
+    assert app.state.load_measured(stiff, "s.csv")
+    app.tabs.active = 0
+    x, y = xy(app.plots.frame(("magnitude", "frequency")), "measured")
+    assert len(x) == 150 and np.all(y > 0)
+    points = app.state.measured_points()
+    assert_allclose(y, points["magnitude"])
+    assert_allclose(x, points["frequency_hz"])
+    app.tabs.active = 3  # the residual plots hold the state's numbers
+    residuals = app.state.measured_residuals()
+    assert_allclose(xy(app.measured.frame("magnitude", "frequency"), "residual")[1],
+                    residuals["magnitude_residual_pct"])
+    # exact data of a bushing 10 % longer (K ∝ L, the loss factor unchanged): the explorer's
+    # design is 1/1.1 − 1 = −9.09 % off at every point, with no loss-factor residual
+    from core.synthetic import synthetic_stiffness
+
+    app.inputs.widgets["shear_modulus_mpa"].value = 2.42
+    longer = synthetic_stiffness(PAPER_B.replace(geometry=PAPER_B.geometry.__class__(0.020, 0.035, 0.099)),
+                                 np.linspace(1, 100, 7), [1e-5, 1e-4, 1e-3], noise=0.0)
+    assert app.state.load_measured(longer.to_csv(), "longer.csv")
+    residuals = app.state.measured_residuals()
+    assert_allclose(residuals["magnitude_residual_pct"], 100 * (1 / 1.1 - 1), rtol=1e-8)
+    assert_allclose(residuals["loss_factor_residual"], 0.0, atol=1e-9)
+    assert residuals["gap"] == pytest.approx(1 / 11, rel=1e-6)  # |K_model − K_data| / |K_data| = 1 − 1/1.1
+    assert_allclose(xy(app.measured.frame("magnitude", "amplitude"), "residual")[1], 100 * (1 / 1.1 - 1), rtol=1e-8)
+    app.tabs.active = 0
+    assert app.state.load_measured_loop(loop_bytes, "l.csv")
+    assert app.state.frequency_hz == pytest.approx(0.1) and app.state.amplitude == pytest.approx(1.0)
+    lx, _ = xy(app.plots.frame("loop"), "measured")
+    assert len(lx) == 400 and np.max(np.abs(lx)) == pytest.approx(1.0, rel=1e-6)
+
+
+def test_dense_data_are_drawn_as_bin_means_with_the_gap_over_every_point(app):
+    from app.curves import DISPLAY_POINTS
+    from core.identify.fit import gap
+    from core.synthetic import synthetic_loop, synthetic_stiffness
+
+    dense = synthetic_stiffness(PAPER_B, np.geomspace(1, 100, 4000), [1e-5, 1e-4, 1e-3], seed=2)
+    assert app.state.load_measured(dense.to_csv(), "dense.csv")
+    app.tabs.active = 0
+    x, _ = xy(app.plots.frame(("magnitude", "frequency")), "measured")
+    assert len(x) == DISPLAY_POINTS
+    every = gap(stiffness_points(app.state.design, dense.frequency_hz, dense.amplitude), dense.stiffness)
+    assert app.state.measured_residuals()["gap"] == pytest.approx(every, rel=1e-9)
+    app.tabs.active = 3
+    assert f"drawn as {DISPLAY_POINTS} bin means" in app.measured.summary.object
+    loop = synthetic_loop(PAPER_B, 1.0, 1e-4, periods=4, per_period=5000, seed=3)
+    assert app.state.load_measured_loop(loop.to_csv(), "long_loop.csv")
+    app.tabs.active = 0
+    lx, _ = xy(app.plots.frame("loop"), "measured")
+    assert len(lx) == DISPLAY_POINTS and np.max(np.abs(lx)) == pytest.approx(0.1, rel=0.01)  # 1e-4 m in mm
+
+
+def test_bad_files_leave_a_message_and_the_session_going(app):
+    assert not app.state.load_measured(b"frequency_hz,amplitude,magnitude,loss_factor\n10,1e-4,abc,0.1\n", "bad.csv")
+    assert app.state.data_message == "bad.csv: line 2: magnitude is not a number ('abc')"
+    assert app.state.measured is None
+    app.tabs.active = 3
+    assert "line 2" in app.measured.message.object
+    assert not app.state.load_measured_loop(b"", "empty.csv")
+    assert "empty" in app.state.data_message
+    app.measured.stiffness_file.value = {"binary.csv": b"\xff\xfe"}  # not even text (as the drop area gives it)
+    assert "UTF-8" in app.state.data_message and "binary.csv" in app.state.data_message
+    assert app.state.errors == {} and app.state.design == PAPER_B
+
+
+def test_fit_in_the_app_and_take_it_into_the_explorer(app):
+    stiff, loop_bytes = example_files()
+    app.state.load_measured(stiff)
+    app.state.load_measured_loop(loop_bytes)
+    app.state.param.update(shear_modulus_mpa=1.5, friction_strain_half=2e-3)
+    app.tabs.active = 3
+    app.state.run_fit()
+    r = app.state.fit_result
+    assert r.gap < 0.01 and not app.measured.use.disabled
+    assert "Correlation" in app.measured.results.object
+    f_op, x_op = app.state.frequency_hz, app.state.amplitude
+    app.state.use_fit()
+    assert app.state.design.material.shear_modulus == pytest.approx(r.design.material.shear_modulus, rel=1e-9)
+    assert (app.state.frequency_hz, app.state.amplitude) == (f_op, x_op)
+    assert app.state.measured_residuals()["gap"] == pytest.approx(r.gap, rel=1e-6)
+    fitted = loads_design(app.measured._fitted_json().getvalue())
+    assert fitted.material == r.design.material
+
+
+def test_a_fit_the_data_cannot_determine_says_so_in_the_app(app):
+    """The single-amplitude sweep: µ and ε½ are not determined; the table says so, shows no
+    standard error for them, the warnings are above the table."""
+    sweep = (Path(__file__).resolve().parent.parent / "examples" / "paper_b_sweep_0.1mm.csv").read_bytes()
+    assert app.state.load_measured(sweep, "paper_b_sweep_0.1mm.csv")
+    app.tabs.active = 3
+    app.state.run_fit()
+    r = app.state.fit_result
+    assert "shear_modulus" in r.undetermined
+    text = app.measured.results.object
+    row = next(line for line in text.splitlines() if line.startswith("| µ"))
+    assert row.split("|")[3].strip() == "–" and "not bounded" in row and "**not determined**" in row
+    assert "⚠ shear_modulus is not determined by these data" in text
+
+
+def test_fit_without_data_says_so(app):
+    app.state.run_fit()
+    assert "load measured" in app.state.data_message and app.state.fit_result is None
+
+
+def test_the_thesis_two_step_fit_in_the_app(app):
+    stiff, loop_bytes = example_files()
+    app.state.load_measured(stiff)
+    app.state.fit_method = "two-step"
+    app.state.run_fit()
+    assert "loop" in app.state.data_message  # needs both
+    app.state.load_measured_loop(loop_bytes)
+    app.tabs.active = 3
+    assert len(app.measured.sweep.options) == 5 and app.measured.sweep.visible
+    app.measured.sweep.value = 1e-4
+    app.state.run_fit()
+    r = app.state.fit_result
+    assert r.method == "two-step" and r.points == 30  # the 0.1 mm sweep
+    assert app.state.data_message == ""  # the earlier refusal is no longer shown
+    assert r.design.material.shear_modulus == pytest.approx(2.42e6, rel=0.03)
+    assert "two-step" in app.measured.results.object

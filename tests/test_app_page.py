@@ -1,0 +1,227 @@
+"""What the explorer's page gets, without a browser: shared and padded axes, legends, only the
+data that changed, no WebGL, a PNG name per plot, the patched Panel and Bokeh internals, a
+session's memory kept flat, and hostile values from the page."""
+
+
+import numpy as np
+import pytest
+
+from app.main import App
+from core import PAPER_B
+from tests.helpers import figures, rendered, xy
+
+
+@pytest.fixture
+def app():
+    return App()
+
+
+def test_axes_of_a_quantity_are_shared_and_cover_every_curve(app):
+    """Plots of the same quantity share one Bokeh range (linked by their HoloViews dimension);
+    after a design change it covers every curve on it, padded by 5 % of the span each side."""
+    doc = rendered(app.template())
+    app.state.shear_modulus_mpa = 3.3
+    figs = figures(doc)
+    k_f, k_a = figs["|K| against frequency"], figs["|K| against amplitude"]
+    eta_f = figs["Loss factor against frequency"]
+    assert k_f.y_range is k_a.y_range and k_f.x_range is eta_f.x_range
+    shown = [np.concatenate([el.dimension_values(1) for el in app.plots.frame(("magnitude", a)) if el.label])
+             for a in ("frequency", "amplitude")]
+    both = np.concatenate(shown)
+    span = both.max() - both.min()
+    assert (k_f.y_range.start, k_f.y_range.end) == pytest.approx((both.min() - 0.05 * span, both.max() + 0.05 * span))
+    x = xy(app.plots.frame(("magnitude", "amplitude")), "operating point")[0]
+    lo, hi = np.log10(x.min()), np.log10(x.max())
+    assert np.log10([k_a.x_range.start, k_a.x_range.end]) == pytest.approx([lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo)])
+    assert x.min() == pytest.approx(app.state.amplitude_bounds[0])
+
+
+def test_legends_hide_curves_on_click_and_follow_the_overlay(app):
+    """A legend entry hides its curve on a click (muted, drawn transparent: HoloViews keeps a
+    glyph muted through updates, not hidden); the entries follow the overlay's curves."""
+    doc = rendered(app.template())
+    fig = figures(doc)["|K| against frequency"]
+    (legend,) = fig.legend
+    assert legend.click_policy == "mute"  # and a muted curve is fully transparent: hidden
+    assert {r.muted_glyph.line_alpha for item in legend.items for r in item.renderers
+            if hasattr(r.muted_glyph, "line_alpha")} == {0.0}
+    shown = [item.label["value"] for item in legend.items]
+    assert shown == [el.label for el in app.plots.frame(("magnitude", "frequency")) if el.label]
+    app.state.pin_reference()  # a new curve: a new legend entry, from HoloViews
+    app.state.length_mm = 80.0
+    assert "reference" in [item.label["value"] for item in legend.items]
+    app.state.clear_reference()
+    assert "reference" not in [item.label["value"] for item in legend.items]
+
+
+def test_only_changed_data_are_sent(app):
+    """An amplitude change sends the loop and the operating curves against frequency; the
+    sweeps and the curves against amplitude keep their data sources untouched (the browser does
+    not repaint them), and the markers on the amplitude axes move."""
+    from bokeh.document.events import ColumnDataChangedEvent, ModelChangedEvent
+    from bokeh.models import ColumnDataSource, Span
+
+    doc = rendered(app.template())
+    names = {}
+    for title, fig in figures(doc).items():
+        for item in fig.legend[0].items if fig.legend else []:
+            for r in item.renderers:
+                names[r.data_source.id] = (title, item.label["value"])
+    events = []
+    doc.on_change(events.append)
+    app.state.amplitude = app.state.amplitude * 1.7
+    changed = {names[e.model.id] for e in events if isinstance(e, (ModelChangedEvent, ColumnDataChangedEvent))
+               and isinstance(e.model, ColumnDataSource) and e.model.id in names}
+    loop_title = "Hysteresis loop at the operating point"
+    expected = {(loop_title, name) for name in ("elastic", "viscoelastic", "friction", "total")}
+    expected |= {(t, "operating point") for t in ("|K| against frequency", "Loss factor against frequency")}
+    assert changed == expected
+    moved = [e.model for e in events if isinstance(e, ModelChangedEvent) and isinstance(e.model, Span)]
+    assert len(moved) == 2 and all(m.location == app.state.amplitude for m in moved)
+
+
+def test_unchanged_elements_are_kept_as_they_were():
+    import holoviews as hv
+
+    from app.elements import curve
+    from app.live import reuse_unchanged
+
+    x, y = hv.Dimension("x"), hv.Dimension("y")
+    a = curve([1.0, np.nan], [2.0, 3.0], x, y, "a")
+    same = curve([1.0, np.nan], [2.0, 3.0], x, y, "a")
+    other = curve([1.0, np.nan], [2.0, 3.5], x, y, "a")
+    relabelled = curve([1.0, np.nan], [2.0, 3.0], x, y, "b")
+    old = hv.Overlay([a, hv.VLine(1.0)])
+    assert reuse_unchanged(old, hv.Overlay([same, hv.VLine(1.0)])) is old
+    kept = reuse_unchanged(old, hv.Overlay([other, hv.VLine(1.0)]))
+    assert kept.get(0) is not a and kept.get(1) is old.get(1)
+    assert reuse_unchanged(old, hv.Overlay([relabelled, hv.VLine(1.0)])).get(0) is not a
+    assert reuse_unchanged(old, hv.Overlay([same, hv.VLine(2.0)])).get(0) is a
+    assert reuse_unchanged(old, hv.Overlay([same])).get(0) is same  # another structure: all new
+
+
+def test_the_page_has_no_webgl_and_each_plot_saves_its_own_png(app):
+    from bokeh.models import SaveTool
+
+    figs = figures(rendered(app.template()))
+    assert {f.output_backend for f in figs.values()} == {"canvas"}
+    names = {t: [tool.filename for tool in f.toolbar.tools if isinstance(tool, SaveTool)] for t, f in figs.items()}
+    assert names["|K| against frequency"] == ["bushing-magnitude-vs-frequency"]
+    assert names["Hysteresis loop at the operating point"] == ["bushing-hysteresis-loop"]
+
+
+def test_the_mathjax_patch_is_in_effect():
+    """app.patches changes one Panel internal: fail loudly when a Panel upgrade removes it."""
+    from panel.io import resources
+
+    from app import patches
+
+    assert patches.PATCHED and resources._panel_use_mathjax is patches.holds_math
+
+
+def test_the_slider_keeps_its_own_position(app):
+    """A slider move sets the amplitude to 4 digits; the slider is not sent back to it."""
+    slider = app.inputs.amplitude.slider
+    slider.value = -1.2345678
+    assert app.state.amplitude == float(f"{10**-1.2345678:.4g}")
+    assert slider.value == -1.2345678
+    app.state.amplitude = 0.5  # set elsewhere (a tap): the slider follows
+    assert slider.value == pytest.approx(np.log10(0.5))
+    slider.value = -1.2345678
+    app.state.shear_modulus_mpa = 2.5  # a new design with the same amplitude bounds
+    assert slider.value == -1.2345678
+    app.state.friction_strain_half = app.state.friction_strain_half * 1000  # new bounds
+    lo, hi = app.state.amplitude_bounds
+    assert np.log10(lo) <= slider.value <= np.log10(hi)
+    assert abs(slider.value - np.log10(app.state.amplitude)) <= slider.step / 2
+
+
+def test_a_change_walks_the_document_only_when_it_adds_models(app):
+    """app.patches.frozen_models: a change that only moves data recomputes no model set; one that
+    adds glyphs (a pinned reference) does, so the new models are in the document."""
+    from bokeh.models import GlyphRenderer
+    from panel.io.state import set_curdoc
+
+    doc = rendered(app.template())
+    with set_curdoc(doc):  # the first change gives the text panes the template's theme (new models)
+        app.state.shear_modulus_mpa = 2.7
+    walks = []
+    recompute = doc.models.recompute
+    doc.models.recompute = lambda: walks.append(1) or recompute()
+    with set_curdoc(doc):
+        app.state.shear_modulus_mpa = 2.8
+        app.state.amplitude = 0.2
+        assert walks == []
+        app.state.pin_reference()
+        app.state.length_mm = 80.0
+    assert walks
+    fig = figures(doc)["|K| against frequency"]
+    (reference,) = [r for item in fig.legend[0].items if item.label["value"] == "reference" for r in item.renderers]
+    assert isinstance(reference, GlyphRenderer) and doc.get_model_by_id(reference.id) is reference
+    assert doc.get_model_by_id(reference.data_source.id) is reference.data_source
+
+
+def test_the_private_internals_used_are_there():
+    """app.patches relies on these Bokeh internals (checked against Bokeh 3.9)."""
+    from bokeh.document.models import DocumentModelManager
+
+    for name in ("_freeze_count", "_push_freeze", "_pop_freeze", "invalidate", "recompute"):
+        assert hasattr(DocumentModelManager, name) or name == "_freeze_count"
+    from bokeh.document import Document
+
+    assert Document().models._freeze_count == 0
+
+
+def test_the_state_and_the_curves_need_no_panel_and_no_plotting():
+    """The session's state and the curves are plain Python: usable without a server or a plot."""
+    import subprocess
+    import sys
+
+    code = ("import sys, app.state, app.curves, app.diagnosis_state; "
+            "print(sorted(m for m in ('panel', 'holoviews', 'bokeh') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+
+
+def test_changes_add_no_styles_and_no_options_entries(app):
+    """Every plotted element is a clone of a styled template: changes add no template and no
+    entry to HoloViews' options store (a session's memory stays flat however long it runs)."""
+    import holoviews as hv
+
+    from app import elements
+
+    app.state.shear_modulus_mpa = 2.5  # every style in use once
+    app.state.amplitude = 0.3
+    templates, entries = elements.template.cache_info().currsize, len(hv.Store.custom_options())
+    for i in range(15):
+        app.state.shear_modulus_mpa = 2.0 + 0.01 * i
+        app.state.amplitude = 0.05 + 0.01 * i
+    assert elements.template.cache_info().currsize == templates
+    assert len(hv.Store.custom_options()) == entries
+
+
+def test_hostile_values_from_the_page_leave_a_message_or_nothing(app, caplog):
+    """Values a hostile page (or a slip) sends: a message beside the field, or nothing moves;
+    no traceback in the log, the session goes on."""
+    slider = app.inputs.amplitude.slider
+    before = app.state.amplitude
+    slider.value = 400.0  # 10^400 mm: beyond any float
+    assert app.state.amplitude == pytest.approx(app.state.amplitude_bounds[1], rel=1e-3)
+    slider.value = float("nan")
+    assert np.isfinite(app.state.amplitude)
+    app.state.amplitude = before
+    app.state.friction_strain_half = 1e-300
+    assert "friction_strain_half" in app.state.errors and app.state.design == PAPER_B
+    app.state.length_mm = 1e308
+    assert "length_mm" in app.state.errors
+    app.state.param.update(friction_strain_half=0.004, length_mm=90.0)
+    assert app.state.errors == {}
+    t = np.linspace(0, 10, 400, endpoint=False)
+    tiny = "time_s,displacement,force\n" + "".join(
+        f"{ti},{1e-16 * np.sin(2 * np.pi * 0.1 * ti)},{np.sin(2 * np.pi * 0.1 * ti)}\n" for ti in t)
+    assert not app.state.load_measured_loop(tiny, "tiny.csv")
+    assert "outside this bushing's amplitude axis" in app.state.data_message
+    app.tabs.active = 3
+    app.measured.stiffness_file.value = {"empty.csv": ""}  # an empty file: its own message, not the last one
+    assert app.state.data_message.startswith("empty.csv: ") and "empty" in app.state.data_message
+    assert not [r for r in caplog.records if r.exc_info]
