@@ -1,0 +1,1 @@
+"""The browser explorer: Panel views over a param state; the plotting API in HoloViews."""

@@ -95,7 +95,7 @@ def friction_modulus(strain_amplitude, friction_stress_max: float, friction_stra
 def fractional_modulus(frequency_hz, fractional_coefficient: float, fractional_order: float):
     """Fractional-branch modulus m (iω)^α / 2 in Pa (eq 5 over 2, since σ = 2µε)."""
     omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
-    return fractional_coefficient * (1j * omega) ** fractional_order / 2.0
+    return fractional_coefficient * (1j * omega) ** fractional_order / 2.0  # eqs 2, 5
 
 
 def equivalent_modulus(material: Material, frequency_hz, strain_amplitude):
@@ -104,7 +104,7 @@ def equivalent_modulus(material: Material, frequency_hz, strain_amplitude):
     ``material`` is a :class:`Material`, or any object with its five fields as arrays that
     broadcast with the two arguments (e.g. one value per Monte Carlo sample, shaped (n, 1, …),
     as :mod:`core.whatif.tolerance` gives): the result then has a row per sample."""
-    return (
+    return (  # eq 16: the linear part µ + m(iω)^α/2 is eqs 8–9's µ(ω), the friction part eq 6's
         material.shear_modulus
         + fractional_modulus(
             frequency_hz, material.fractional_coefficient, material.fractional_order
@@ -205,7 +205,7 @@ class BranchStresses:
 
     @property
     def total(self) -> np.ndarray:
-        return self.elastic + self.fractional + self.friction
+        return self.elastic + self.fractional + self.friction  # eq 7
 
 
 def branch_stresses(

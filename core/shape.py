@@ -66,9 +66,9 @@ def long_shape_factor(a: float, b: float, L: float, mode: str) -> float:
     """The closed form of ``mode`` (torsion exact; axial and radial for a long bushing)."""
     a, b, L = _radii(a, b, L)
     if mode == "axial":
-        return 2.0 * math.pi * L / math.log(b / a)
+        return 2.0 * math.pi * L / math.log(b / a)  # eq 18
     if mode == "torsion":
-        return 4.0 * math.pi * a * a * b * b * L / (b * b - a * a)
+        return 4.0 * math.pi * a * a * b * b * L / (b * b - a * a)  # eq 17
     if mode == "radial":
         s = a * a + b * b
         return 4.0 * math.pi * L * s / (s * math.log(b / a) - (b * b - a * a))
@@ -90,7 +90,7 @@ def reference_shape_factor(a: float, b: float, L: float, mode: str) -> float:
 
 def strain_factor_from_shape(S: float, a: float, b: float, L: float) -> float:
     """c in ε_eq = c · x̂ from the energy balance: √(S / (4V)), V = π(b² − a²)L."""
-    return math.sqrt(S / (4.0 * math.pi * (b * b - a * a) * L))
+    return math.sqrt(S / (4.0 * math.pi * (b * b - a * a) * L))  # eqs 12–13
 
 
 # ---- the finite-element model -------------------------------------------------------------

@@ -68,6 +68,8 @@ def continuum_nodes(geometry: Geometry, mode: str, n: int | None = None) -> Seri
     log_ratio = np.log(b / a)
     r = a * np.exp(t * log_ratio)
     wr = w * log_ratio * r  # dr = r ln(b/a) dt
+    # the stress per load at each radius: with a uniform modulus the strain then falls as 1/r²
+    # in torsion (eq 10) and as 1/r axially (eq 11)
     if mode == "torsion":
         return SeriesNodes(1.0 / (2.0 * np.pi * r * r * L), wr / (2.0 * np.pi * r**3 * L))
     return SeriesNodes(1.0 / (2.0 * np.pi * r * L), wr / (2.0 * np.pi * r * L))
