@@ -32,9 +32,12 @@ from scipy import linalg, stats
 from ..bushing import MAX_STRAIN, factors, shape_factor, stiffness_points, strain_factor
 from ..data import loss_factor
 from ..design import Design, DesignError, Geometry, strict_json
-from ..identify.fit import FitResult, parameter
+from ..identify.fit import FitResult
 from ..material import fractional_modulus, friction_modulus
-from .sensitivity import GEOMETRY_PARAMETERS, SENSITIVITY_PARAMETERS, log_derivatives, value_of
+from ..parameters import GEOMETRY as GEOMETRY_PARAMETERS
+from ..parameters import NAMES as SENSITIVITY_PARAMETERS
+from ..registry import parameter
+from .sensitivity import log_derivatives, value_of
 
 DISTRIBUTIONS = ("uniform", "normal")
 SAMPLES = 500  # the default sample count
