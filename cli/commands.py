@@ -22,6 +22,7 @@ from core.bushing import MAX_SLICES, loop, slice_count, stiffness
 from core.data import MAX_ROWS, DataError, csv_text
 from core.design import DesignError, read_design, read_design_file
 from core.material import ConvergenceError
+from core.parameters import BRANCH_PARAMETERS, BY_NAME, MATERIAL, MODE, ROTATIONS, TRANSLATIONS
 
 NUMBER_FORMAT = "{:.12g}"
 # the largest sizes the command line computes (docs/files.md): a grid of at most a million
@@ -33,6 +34,10 @@ MAX_GRID = 1_000_000
 MAX_SLICE_POINTS = {"analytic": 20_000_000, "time-domain": 600}
 MAX_LOOP_POINTS = 1_000_000
 NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+# the units of the card's amplitudes: the translations' displacement as people read it (mm), the
+# rotations' angle in SI (rad)
+CARD_DISPLACEMENT = MODE[TRANSLATIONS[0]].amplitude
+CARD_ANGLE = MODE[ROTATIONS[0]].amplitude.si
 
 
 class InputError(Exception):
@@ -90,7 +95,8 @@ def build_parser() -> argparse.ArgumentParser:
         "amplitude, stiffness_real, stiffness_imag, magnitude, loss_factor (one row per "
         "amplitude and frequency; N/m axially, N·m/rad in torsion).",
     )
-    _grid_arguments(st, "peak amplitudes: displacement in m (axial, radial) or angle in rad (torsion, conical)")
+    _grid_arguments(st, f"peak amplitudes: displacement in m ({', '.join(TRANSLATIONS)}) or angle in rad "
+                        f"({', '.join(ROTATIONS)})")
     group = st.add_mutually_exclusive_group()
     group.add_argument(
         "--slices",
@@ -133,7 +139,7 @@ def build_parser() -> argparse.ArgumentParser:
     ft = sub.add_parser(
         "fit",
         help="identify the five material parameters from measured data",
-        description="Fit µ, m, α, σ_fmax and ε½ to measured dynamic stiffness (and a measured "
+        description=f"Fit {_symbols(MATERIAL)} to measured dynamic stiffness (and a measured "
         "loop) from several starting points; the design's material is the first. Writes the "
         "design file with the fitted material and a `fit` object: standard_errors, "
         "correlation, gap.",
@@ -156,18 +162,19 @@ def build_parser() -> argparse.ArgumentParser:
         "to standard output, or to --json with a summary in plain words on standard output.",
     )
     _measured_arguments(dg, "geometry (known), mode and starting parameters")
-    dg.add_argument("--baseline", default="elastic,fractional,friction", metavar="IDS",
+    dg.add_argument("--baseline", default=",".join(BRANCH_PARAMETERS), metavar="IDS",
                     help="the branches the starting model has, comma-separated from "
-                    "elastic,fractional,friction (default: all three)")
+                    f"{','.join(BRANCH_PARAMETERS)} (default: all three)")
     dg.add_argument("--json", dest="report", metavar="REPORT.json", help="write the report here")
     dg.add_argument("--predictions", metavar="PRED.csv",
                     help="write, per data row, the baseline's and the final model's |K| and loss factor")
 
     cd = sub.add_parser(
         "card",
-        help="every direction at one operating point: axial, radial, torsion, conical (CSV)",
+        help=f"every direction at one operating point: {', '.join(TRANSLATIONS + ROTATIONS)} (CSV)",
         description="The bushing card: the dynamic stiffness in the four directions at one "
-        "frequency, axial and radial at D mm, torsion and conical at R rad, with finite-length "
+        f"frequency, {' and '.join(TRANSLATIONS)} at D {CARD_DISPLACEMENT.display}, {' and '.join(ROTATIONS)} "
+        f"at R {CARD_ANGLE}, with finite-length "
         "shape factors (the design's shape 'long' keeps the closed forms for axial and torsion). "
         "Writes CSV with columns mode, amplitude (m or rad), stiffness_real, stiffness_imag, "
         "magnitude, loss_factor, shape_factor.",
@@ -175,9 +182,10 @@ def build_parser() -> argparse.ArgumentParser:
     cd.add_argument("design", metavar="DESIGN.json", help="design file (docs/files.md); its mode is not used")
     cd.add_argument("--freq", required=True, type=_positive("--freq"), metavar="F", help="Hz")
     cd.add_argument("--amp-mm", required=True, type=_positive("--amp-mm"), metavar="D",
-                    help="peak displacement of the axial and radial directions, mm")
+                    help=f"peak displacement of the {' and '.join(TRANSLATIONS)} directions, "
+                    f"{CARD_DISPLACEMENT.display}")
     cd.add_argument("--amp-rad", required=True, type=_positive("--amp-rad"), metavar="R",
-                    help="peak angle of the torsion and conical directions, rad")
+                    help=f"peak angle of the {' and '.join(ROTATIONS)} directions, {CARD_ANGLE}")
     cd.add_argument("-o", dest="output", metavar="CARD.csv", help="write here, not to stdout")
 
     ex = sub.add_parser(
@@ -204,6 +212,12 @@ def build_parser() -> argparse.ArgumentParser:
                     help="write the report here (the statement goes to stdout), not to stdout")
 
     return parser
+
+
+def _symbols(names: tuple[str, ...]) -> str:
+    """The parameters' symbols in a sentence: ``µ, m, α, σ_fmax and ε½``."""
+    symbols = [BY_NAME[n].symbol for n in names]
+    return f"{', '.join(symbols[:-1])} and {symbols[-1]}"
 
 
 def _grid_arguments(parser: argparse.ArgumentParser, amp_help: str) -> None:
@@ -443,7 +457,7 @@ def _cmd_card(args) -> None:
     from core.card import card
 
     design = read_design(args.design)
-    rows = card(design, args.freq, args.amp_mm * 1e-3, args.amp_rad)
+    rows = card(design, args.freq, float(CARD_DISPLACEMENT.to_si(args.amp_mm)), args.amp_rad)
     numbers = _finite({k: np.array([r[k] for r in rows]) for k in rows[0] if k != "mode"})
     _write_csv({"mode": [r["mode"] for r in rows], **numbers}, args.output)
 

@@ -25,15 +25,9 @@ from . import material as mat
 from .data import ComplexStiffness, loss_factor
 from .design import Design
 from .effects import EFFECTS, branch_moduli, extended_modulus, inertia_correction, wave_stiffness
+from .parameters import MODE, THESIS_MODES
 from .shape import shape_factor, strain_factor
 from .slices import continuum_node_count, continuum_nodes, slice_nodes, solve_series
-
-UNITS = {
-    "axial": {"amplitude": "m", "stiffness": "N/m", "force": "N", "drive": "displacement"},
-    "torsion": {"amplitude": "rad", "stiffness": "N·m/rad", "force": "N·m", "drive": "angle"},
-    "radial": {"amplitude": "m", "stiffness": "N/m", "force": "N", "drive": "displacement"},
-    "conical": {"amplitude": "rad", "stiffness": "N·m/rad", "force": "N·m", "drive": "angle"},
-}
 
 Route = Literal["analytic", "time-domain"]
 ROUTES = ("analytic", "time-domain")
@@ -86,7 +80,7 @@ class StiffnessResult(ComplexStiffness):
 
     @property
     def units(self) -> dict[str, str]:
-        return {"frequency_hz": "Hz", **UNITS[self.mode]}
+        return {"frequency_hz": "Hz", **MODE[self.mode].units}
 
     def table(self) -> dict[str, np.ndarray]:
         """Flat columns in docs/files.md's order, amplitude by amplitude, each a frequency sweep."""
@@ -163,7 +157,7 @@ def _check_series(design: Design, slices: int | str) -> None:
     """Slices, the continuum and standing waves are derived for the thesis' axial and torsion
     bushings (long shape factors): refuse them elsewhere rather than guess."""
     series = slices != 1 or "wave_effects" in design.effect_parameters
-    if series and (design.mode not in ("axial", "torsion") or design.shape_kind != "long"):
+    if series and (design.mode not in THESIS_MODES or design.shape_kind != "long"):
         what = "slices, the continuum, nonuniform_strain and wave_effects"
         raise ValueError(f"{what} are derived for axial and torsion bushings with the long (closed-form) shape "
                          f"factors; this design is {design.mode} with the {design.shape_kind} shape")
@@ -186,7 +180,7 @@ def check_strain(design: Design, amplitude, what: str = "amplitude") -> None:
     x = np.asarray(amplitude, dtype=float)
     c = strain_factor(design.geometry, design.mode, design.shape)
     if x.size and float(np.max(c * x)) > MAX_STRAIN:
-        unit = UNITS[design.mode]["amplitude"]
+        unit = MODE[design.mode].amplitude.si
         largest = MAX_STRAIN / c
         raise ValueError(f"{what}: at most {largest:.4g} {unit} for this bushing (an equivalent strain of "
                          f"{MAX_STRAIN:g}, {100 * MAX_STRAIN:g} %); got {float(np.max(x)):.4g} {unit}")
@@ -199,7 +193,7 @@ def check_measured_amplitude(design: Design, amplitude, what: str = "measured am
     x = np.asarray(amplitude, dtype=float)
     c = strain_factor(design.geometry, design.mode, design.shape)
     if x.size and float(np.min(c * x)) < MIN_MEASURED_STRAIN:
-        unit = UNITS[design.mode]["amplitude"]
+        unit = MODE[design.mode].amplitude.si
         raise ValueError(f"{what}: at least {MIN_MEASURED_STRAIN / c:.3g} {unit} for this bushing (an equivalent "
                          f"strain of {MIN_MEASURED_STRAIN:g}, below any test's resolution); got "
                          f"{float(np.min(x)):.3g} {unit}: are the units those of docs/files.md (m or rad)?")
@@ -336,7 +330,7 @@ class LoopResult:
 
     @property
     def units(self) -> dict[str, str]:
-        return UNITS[self.design.mode]
+        return MODE[self.design.mode].units
 
     def table(self) -> dict[str, np.ndarray]:
         return {
