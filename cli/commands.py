@@ -22,7 +22,7 @@ from core.bushing import MAX_SLICES, loop, slice_count, stiffness
 from core.data import MAX_ROWS, DataError, csv_text
 from core.design import DesignError, read_design, read_design_file
 from core.material import ConvergenceError
-from core.parameters import BRANCH_PARAMETERS, BY_NAME, MATERIAL, MODE, ROTATIONS, TRANSLATIONS
+from core.parameters import BRANCH_PARAMETERS, MODE, ROTATIONS, TRANSLATIONS
 
 NUMBER_FORMAT = "{:.12g}"
 # the largest sizes the command line computes (docs/files.md): a grid of at most a million
@@ -34,10 +34,7 @@ MAX_GRID = 1_000_000
 MAX_SLICE_POINTS = {"analytic": 20_000_000, "time-domain": 600}
 MAX_LOOP_POINTS = 1_000_000
 NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
-# the units of the card's amplitudes: the translations' displacement as people read it (mm), the
-# rotations' angle in SI (rad)
-CARD_DISPLACEMENT = MODE[TRANSLATIONS[0]].amplitude
-CARD_ANGLE = MODE[ROTATIONS[0]].amplitude.si
+CARD_DISPLACEMENT = MODE[TRANSLATIONS[0]].amplitude  # the card's displacements: in mm, as people read them
 
 
 class InputError(Exception):
@@ -139,7 +136,7 @@ def build_parser() -> argparse.ArgumentParser:
     ft = sub.add_parser(
         "fit",
         help="identify the five material parameters from measured data",
-        description=f"Fit {_symbols(MATERIAL)} to measured dynamic stiffness (and a measured "
+        description="Fit µ, m, α, σ_fmax and ε½ to measured dynamic stiffness (and a measured "
         "loop) from several starting points; the design's material is the first. Writes the "
         "design file with the fitted material and a `fit` object: standard_errors, "
         "correlation, gap.",
@@ -174,7 +171,7 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"every direction at one operating point: {', '.join(TRANSLATIONS + ROTATIONS)} (CSV)",
         description="The bushing card: the dynamic stiffness in the four directions at one "
         f"frequency, {' and '.join(TRANSLATIONS)} at D {CARD_DISPLACEMENT.display}, {' and '.join(ROTATIONS)} "
-        f"at R {CARD_ANGLE}, with finite-length "
+        "at R rad, with finite-length "
         "shape factors (the design's shape 'long' keeps the closed forms for axial and torsion). "
         "Writes CSV with columns mode, amplitude (m or rad), stiffness_real, stiffness_imag, "
         "magnitude, loss_factor, shape_factor.",
@@ -185,7 +182,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help=f"peak displacement of the {' and '.join(TRANSLATIONS)} directions, "
                     f"{CARD_DISPLACEMENT.display}")
     cd.add_argument("--amp-rad", required=True, type=_positive("--amp-rad"), metavar="R",
-                    help=f"peak angle of the {' and '.join(ROTATIONS)} directions, {CARD_ANGLE}")
+                    help=f"peak angle of the {' and '.join(ROTATIONS)} directions, rad")
     cd.add_argument("-o", dest="output", metavar="CARD.csv", help="write here, not to stdout")
 
     ex = sub.add_parser(
@@ -212,12 +209,6 @@ def build_parser() -> argparse.ArgumentParser:
                     help="write the report here (the statement goes to stdout), not to stdout")
 
     return parser
-
-
-def _symbols(names: tuple[str, ...]) -> str:
-    """The parameters' symbols in a sentence: ``µ, m, α, σ_fmax and ε½``."""
-    symbols = [BY_NAME[n].symbol for n in names]
-    return f"{', '.join(symbols[:-1])} and {symbols[-1]}"
 
 
 def _grid_arguments(parser: argparse.ArgumentParser, amp_help: str) -> None:
