@@ -10,8 +10,7 @@ import math
 
 import param
 
-from core.identify.fit import PARAMETERS as MATERIAL_PARAMETERS
-from core.parameters import PARAMETERS
+from core.parameters import MATERIAL, PARAMETERS
 from core.whatif.tolerance import SAMPLES, FitCovariance, ToleranceError, Tolerances
 
 # a parameter's key in the tolerances of a link (tol=mu:10,L:1)
@@ -70,7 +69,7 @@ class ToleranceBands(param.Parameterized):
         when bands are off or nothing varies. Raises ToleranceError with the reason."""
         if not self.band_on:
             return None
-        material = set(MATERIAL_PARAMETERS) if self.band_from_fit else set()
+        material = set(MATERIAL) if self.band_from_fit else set()
         relative = {n: v / 100.0 for n, v in self.tolerance_pct.items() if v and n not in material}
         covariance = None
         if self.band_from_fit:

@@ -22,9 +22,10 @@ from core.bushing import (
 )
 from core.card import CARD_MODES, card_design
 from core.data import MeasuredLoop, MeasuredStiffness, loss_factor, magnitude_residual_pct
-from core.identify.fit import folded, gap, model_stiffness, selection
+from core.identify.fit import folded, model_stiffness, selection
 from core.loops import loop
 from core.material import ConvergenceError
+from core.residuals import gap
 from core.whatif.tolerance import band
 
 from . import units

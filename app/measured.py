@@ -12,8 +12,7 @@ import panel as pn
 import param
 
 from core import PAPER_B
-from core.identify.fit import PARAMETERS
-from core.parameters import BY_NAME
+from core.parameters import BY_NAME, MATERIAL
 from core.synthetic import paper_b_example
 
 from . import curves, misfit_plots
@@ -27,7 +26,7 @@ RESIDUALS = (("magnitude", "frequency"), ("loss", "frequency"), ("magnitude", "a
 
 log = logging.getLogger("bushing.app")
 
-FITTED = " and ".join([", ".join(BY_NAME[p].symbol for p in PARAMETERS[:-1]), BY_NAME[PARAMETERS[-1]].symbol])
+FITTED = " and ".join([", ".join(BY_NAME[p].symbol for p in MATERIAL[:-1]), BY_NAME[MATERIAL[-1]].symbol])
 
 
 
@@ -150,7 +149,7 @@ class MeasuredView(PlotView):
     def _results_table(r):
         vague = set(r.undetermined)
         rows = ["| parameter | fitted | ± standard error | 95 % interval (profile) |", "|---|---|---|---|"]
-        for p in PARAMETERS:
+        for p in MATERIAL:
             unit = BY_NAME[p].unit
             value, err = unit.to_display(getattr(r.design.material, p)), unit.to_display(r.standard_errors[p])
             err = "–" if p in vague or not np.isfinite(err) else f"{err:.2g}"
@@ -159,10 +158,10 @@ class MeasuredView(PlotView):
             rows.append(f"| {BY_NAME[p].symbol} ({unit.display}) | {value:.5g} | {err} | {interval} |")
         gap = f"{r.gap:.4f}" if np.isfinite(r.gap) else "–"
         loop = f", loop RMS misfit {r.loop_rms:.4f}" if r.loop_rms is not None else ""
-        corr = ["| | " + " | ".join(BY_NAME[p].symbol for p in PARAMETERS) + " |",
-                "|---" * (len(PARAMETERS) + 1) + "|"]
-        for a in PARAMETERS:
-            corr.append(f"| {BY_NAME[a].symbol} | " + " | ".join(f"{r.correlation[a][b]:+.2f}" for b in PARAMETERS) + " |")
+        corr = ["| | " + " | ".join(BY_NAME[p].symbol for p in MATERIAL) + " |",
+                "|---" * (len(MATERIAL) + 1) + "|"]
+        for a in MATERIAL:
+            corr.append(f"| {BY_NAME[a].symbol} | " + " | ".join(f"{r.correlation[a][b]:+.2f}" for b in MATERIAL) + " |")
         warnings = "".join(f"\n\n⚠ {w}" for w in r.warnings)
         by_mode = ("\n\nGap per mode: " + ", ".join(f"{m} **{g:.4f}**" for m, g in r.gap_by_mode.items())
                    if r.gap_by_mode else "")

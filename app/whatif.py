@@ -12,8 +12,8 @@ import holoviews as hv
 import panel as pn
 import param
 
-from core.parameters import BY_NAME, GEOMETRY, TRANSLATIONS
-from core.whatif.sensitivity import SENSITIVITY_PARAMETERS, SYMBOLS, elasticities, ranked, sentence
+from core.parameters import BY_NAME, GEOMETRY, NAMES, TRANSLATIONS
+from core.whatif.sensitivity import elasticities, ranked, sentence
 from core.whatif.target import Found, TargetError, problem_from_dict, solve
 from core.whatif.tolerance import ToleranceError
 
@@ -80,7 +80,7 @@ class WhatIfView(PlotView):
         self.tolerance_inputs = {
             n: FloatInput(label=f"{BY_NAME[n].label} ± %", value=self._shown_tolerances().get(n, 0.0), start=0.0,
                                      end=89.0, step=0.5, width=170)
-            for n in SENSITIVITY_PARAMETERS}
+            for n in NAMES}
         for name, widget in self.tolerance_inputs.items():
             widget.param.watch(lambda e, n=name: self._set_tolerance(n, e.new), "value")
         s = state.param
@@ -160,7 +160,7 @@ class WhatIfView(PlotView):
         for quantity, label, color in (("magnitude", "∂ln|K| / ∂ln p", "#1f5f8b"),
                                        ("loss_factor", "∂η / ∂ln p", "#2ca02c")):
             order = ranked(values, quantity)
-            bars = hv.Bars([(SYMBOLS[n], v) for n, v in order], kdims=[hv.Dimension("parameter", label="Parameter")],
+            bars = hv.Bars([(BY_NAME[n].symbol, v) for n, v in order], kdims=[hv.Dimension("parameter", label="Parameter")],
                            vdims=[hv.Dimension(f"sensitivity_{quantity}", label=label)])
             title = "|K|: % per +1 % of the parameter" if quantity == "magnitude" else \
                 "Loss factor: change per unit ln p"

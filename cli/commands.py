@@ -23,6 +23,7 @@ from core.data import MAX_ROWS, DataError, csv_text
 from core.design import DesignError, read_design, read_design_file
 from core.loops import loop
 from core.material import ConvergenceError
+from core.parameters import BRANCH_PARAMETERS, MODE, ROTATIONS, TRANSLATIONS
 
 NUMBER_FORMAT = "{:.12g}"
 # the largest sizes the command line computes (docs/files.md): a grid of at most a million
@@ -34,6 +35,7 @@ MAX_GRID = 1_000_000
 MAX_SLICE_POINTS = {"analytic": 20_000_000, "time-domain": 600}
 MAX_LOOP_POINTS = 1_000_000
 NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+CARD_DISPLACEMENT = MODE[TRANSLATIONS[0]].amplitude  # the card's displacements: in mm, as people read them
 
 
 class InputError(Exception):
@@ -91,7 +93,8 @@ def build_parser() -> argparse.ArgumentParser:
         "amplitude, stiffness_real, stiffness_imag, magnitude, loss_factor (one row per "
         "amplitude and frequency; N/m axially, N·m/rad in torsion).",
     )
-    _grid_arguments(st, "peak amplitudes: displacement in m (axial, radial) or angle in rad (torsion, conical)")
+    _grid_arguments(st, f"peak amplitudes: displacement in m ({', '.join(TRANSLATIONS)}) or angle in rad "
+                        f"({', '.join(ROTATIONS)})")
     group = st.add_mutually_exclusive_group()
     group.add_argument(
         "--slices",
@@ -157,18 +160,19 @@ def build_parser() -> argparse.ArgumentParser:
         "to standard output, or to --json with a summary in plain words on standard output.",
     )
     _measured_arguments(dg, "geometry (known), mode and starting parameters")
-    dg.add_argument("--baseline", default="elastic,fractional,friction", metavar="IDS",
+    dg.add_argument("--baseline", default=",".join(BRANCH_PARAMETERS), metavar="IDS",
                     help="the branches the starting model has, comma-separated from "
-                    "elastic,fractional,friction (default: all three)")
+                    f"{','.join(BRANCH_PARAMETERS)} (default: all three)")
     dg.add_argument("--json", dest="report", metavar="REPORT.json", help="write the report here")
     dg.add_argument("--predictions", metavar="PRED.csv",
                     help="write, per data row, the baseline's and the final model's |K| and loss factor")
 
     cd = sub.add_parser(
         "card",
-        help="every direction at one operating point: axial, radial, torsion, conical (CSV)",
+        help=f"every direction at one operating point: {', '.join(TRANSLATIONS + ROTATIONS)} (CSV)",
         description="The bushing card: the dynamic stiffness in the four directions at one "
-        "frequency, axial and radial at D mm, torsion and conical at R rad, with finite-length "
+        f"frequency, {' and '.join(TRANSLATIONS)} at D {CARD_DISPLACEMENT.display}, {' and '.join(ROTATIONS)} "
+        "at R rad, with finite-length "
         "shape factors (the design's shape 'long' keeps the closed forms for axial and torsion). "
         "Writes CSV with columns mode, amplitude (m or rad), stiffness_real, stiffness_imag, "
         "magnitude, loss_factor, shape_factor.",
@@ -176,9 +180,10 @@ def build_parser() -> argparse.ArgumentParser:
     cd.add_argument("design", metavar="DESIGN.json", help="design file (docs/files.md); its mode is not used")
     cd.add_argument("--freq", required=True, type=_positive("--freq"), metavar="F", help="Hz")
     cd.add_argument("--amp-mm", required=True, type=_positive("--amp-mm"), metavar="D",
-                    help="peak displacement of the axial and radial directions, mm")
+                    help=f"peak displacement of the {' and '.join(TRANSLATIONS)} directions, "
+                    f"{CARD_DISPLACEMENT.display}")
     cd.add_argument("--amp-rad", required=True, type=_positive("--amp-rad"), metavar="R",
-                    help="peak angle of the torsion and conical directions, rad")
+                    help=f"peak angle of the {' and '.join(ROTATIONS)} directions, rad")
     cd.add_argument("-o", dest="output", metavar="CARD.csv", help="write here, not to stdout")
 
     ex = sub.add_parser(
@@ -444,7 +449,7 @@ def _cmd_card(args) -> None:
     from core.card import card
 
     design = read_design(args.design)
-    rows = card(design, args.freq, args.amp_mm * 1e-3, args.amp_rad)
+    rows = card(design, args.freq, float(CARD_DISPLACEMENT.to_si(args.amp_mm)), args.amp_rad)
     numbers = _finite({k: np.array([r[k] for r in rows]) for k in rows[0] if k != "mode"})
     _write_csv({"mode": [r["mode"] for r in rows], **numbers}, args.output)
 

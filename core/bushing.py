@@ -26,15 +26,9 @@ from . import material as mat
 from .data import ComplexStiffness, loss_factor
 from .design import Design
 from .effects import EFFECTS, branch_moduli, extended_modulus, inertia_correction, wave_stiffness
+from .parameters import MODE, THESIS_MODES
 from .shape import shape_factor, strain_factor  # noqa: F401 (re-exported)
 from .slices import continuum_node_count, continuum_nodes, slice_nodes, solve_series
-
-UNITS = {
-    "axial": {"amplitude": "m", "stiffness": "N/m", "force": "N", "drive": "displacement"},
-    "torsion": {"amplitude": "rad", "stiffness": "N·m/rad", "force": "N·m", "drive": "angle"},
-    "radial": {"amplitude": "m", "stiffness": "N/m", "force": "N", "drive": "displacement"},
-    "conical": {"amplitude": "rad", "stiffness": "N·m/rad", "force": "N·m", "drive": "angle"},
-}
 
 Route = Literal["analytic", "time-domain"]
 ROUTES = ("analytic", "time-domain")
@@ -89,7 +83,7 @@ class StiffnessResult(ComplexStiffness):
 
     @property
     def units(self) -> dict[str, str]:
-        return {"frequency_hz": "Hz", **UNITS[self.mode]}
+        return {"frequency_hz": "Hz", **MODE[self.mode].units}
 
     def table(self) -> dict[str, np.ndarray]:
         """Flat columns in docs/files.md's order, amplitude by amplitude, each a frequency sweep."""
@@ -166,7 +160,7 @@ def _check_series(design: Design, slices: int | str) -> None:
     """Slices, the continuum and standing waves are derived for the thesis' axial and torsion
     bushings (long shape factors): refuse them elsewhere rather than guess."""
     series = slices != 1 or "wave_effects" in design.effect_parameters
-    if series and (design.mode not in ("axial", "torsion") or design.shape_kind != "long"):
+    if series and (design.mode not in THESIS_MODES or design.shape_kind != "long"):
         what = "slices, the continuum, nonuniform_strain and wave_effects"
         raise ValueError(f"{what} are derived for axial and torsion bushings with the long (closed-form) shape "
                          f"factors; this design is {design.mode} with the {design.shape_kind} shape")
@@ -188,7 +182,7 @@ def check_strain(design: Design, amplitude, what: str = "amplitude") -> None:
     survives them, and the formulas' numbers stop being meaningful long before floats fail."""
     x = np.asarray(amplitude, dtype=float)
     if x.size and float(np.max(design.strain(x))) > MAX_STRAIN:
-        unit = UNITS[design.mode]["amplitude"]
+        unit = MODE[design.mode].amplitude.si
         largest = design.drive(MAX_STRAIN)
         raise ValueError(f"{what}: at most {largest:.4g} {unit} for this bushing (an equivalent strain of "
                          f"{MAX_STRAIN:g}, {100 * MAX_STRAIN:g} %); got {float(np.max(x)):.4g} {unit}")
@@ -200,7 +194,7 @@ def check_measured_amplitude(design: Design, amplitude, what: str = "measured am
     check_strain(design, amplitude, what)
     x = np.asarray(amplitude, dtype=float)
     if x.size and float(np.min(design.strain(x))) < MIN_MEASURED_STRAIN:
-        unit = UNITS[design.mode]["amplitude"]
+        unit = MODE[design.mode].amplitude.si
         smallest = design.drive(MIN_MEASURED_STRAIN)
         raise ValueError(f"{what}: at least {smallest:.3g} {unit} for this bushing (an equivalent "
                          f"strain of {MIN_MEASURED_STRAIN:g}, below any test's resolution); got "

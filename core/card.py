@@ -14,15 +14,16 @@ import numpy as np
 
 from .bushing import factors, stiffness_points
 from .data import loss_factor
-from .design import TRANSLATIONS, Design
+from .design import Design
+from .parameters import ROTATIONS, THESIS_MODES, TRANSLATIONS
 
-CARD_MODES = ("axial", "radial", "torsion", "conical")
+CARD_MODES = TRANSLATIONS + ROTATIONS  # axial, radial, torsion, conical
 
 
 def card_design(design: Design, mode: str) -> Design:
     """``design`` in ``mode`` with the card's shape factor (a test rig's apparent mass stays
     with its own mode, as :meth:`core.design.Design.in_mode` keeps it)."""
-    shape = design.shape if design.shape == "long" and mode in ("axial", "torsion") else "finite"
+    shape = design.shape if design.shape == "long" and mode in THESIS_MODES else "finite"
     return design.replace(mode=mode, shape=shape, effects=design.portable_effects)
 
 

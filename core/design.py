@@ -1,19 +1,7 @@
 """Bushing designs: validated, immutable geometry, material and mode, and the design file.
 
-Symbols (docs/model.md), their names here and units:
-
-====== ========================== ========= =========================================
-symbol name                       unit      meaning
-====== ========================== ========= =========================================
-a      ``inner_radius``           m         inner (bonded) radius
-b      ``outer_radius``           m         outer (bonded) radius, b > a
-L      ``length``                 m         bushing length
-µ      ``shear_modulus``          Pa        elastic shear modulus
-m      ``fractional_coefficient`` Pa·s^α    fractional-derivative coefficient
-α      ``fractional_order``       –         fractional order, 0 < α ≤ 1
-σ_fmax ``friction_stress_max``    Pa        largest friction stress
-ε½     ``friction_strain_half``   –         strain at which half of σ_fmax is built
-====== ========================== ========= =========================================
+The parameters' symbols, names and units are those of the one table, :mod:`core.parameters`
+(docs/model.md, "Symbols and units"): geometry in m, moduli and stresses in Pa.
 
 A value that breaks a rule is refused at the door with a :class:`DesignError` whose message
 names the key (``geometry.outer_radius``) and the rule.
@@ -28,7 +16,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-from .parameters import DEFAULT_SHAPE, MODES, ROTATIONS, SHAPES, TRANSLATIONS  # noqa: F401 (re-exported)
+from .parameters import DEFAULT_SHAPE, MODES, SHAPES
 from .shape import shape_factor, strain_factor
 
 # shape factors: closed forms of long bushings (the thesis'), or finite-length FE (core/shape.py)

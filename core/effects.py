@@ -15,7 +15,6 @@ leaves in measured stiffness. How an effect enters the model is in one of three 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -23,23 +22,14 @@ from typing import Any
 import numpy as np
 from scipy import special
 
-from .design import MODES, ROTATIONS, DesignError, Material, _number
+from .design import DesignError, Material, _number
 from .material import REFERENCE_FREQUENCY_HZ, fractional_modulus, friction_modulus
+from .parameters import BRANCH_PARAMETERS, BY_NAME, MODE, MODES, TRANSLATIONS, Parameter
 
 
-@dataclass(frozen=True)
-class Parameter:
-    name: str
-    unit: str  # its unit; for a parameter whose unit depends on the mode, in the translations
-    meaning: str
-    bounds: tuple[float, float] = (0.0, math.inf)  # the range searched when fitting
-    log: bool = True  # fitted as its logarithm (a scale), or as itself
-    rotation_unit: str | None = None  # its unit in the rotations (ROTATIONS), if not ``unit``
-
-    def unit_in(self, mode: str) -> str:
-        """The parameter's one unit in ``mode``: an apparent mass is in kg in axial and radial
-        (translations), in kg·m² in torsion and conical (rotations)."""
-        return self.rotation_unit if self.rotation_unit and mode in ROTATIONS else self.unit
+def _branch(branch: str) -> tuple[Parameter, ...]:
+    """The parameters of one of the thesis' branches, as the table of design parameters has them."""
+    return tuple(BY_NAME[name].fitting for name in BRANCH_PARAMETERS[branch])
 
 
 @dataclass(frozen=True)
@@ -89,10 +79,7 @@ EFFECTS: dict[str, Effect] = {
         Effect(
             "friction",
             "Amplitude dependence (Fletcher–Gent effect)",
-            (
-                Parameter("friction_stress_max", "Pa", "largest friction stress σ_fmax", (1e-3, 1e9)),
-                Parameter("friction_strain_half", "–", "strain ε½ to build half of σ_fmax", (1e-9, 10.0)),
-            ),
+            _branch("friction"),
             "The carbon-black filler network breaks and re-forms as the rubber is strained: "
             "a rate-independent friction stress that saturates at σ_fmax (Berg's smooth "
             "friction).",
@@ -103,10 +90,7 @@ EFFECTS: dict[str, Effect] = {
         Effect(
             "fractional",
             "Frequency dependence (fractional viscoelasticity)",
-            (
-                Parameter("fractional_coefficient", "Pa·s^α", "fractional coefficient m", (1e-2, 1e11)),
-                Parameter("fractional_order", "–", "fractional order α in (0, 1]", (1e-3, 1.0), log=False),
-            ),
+            _branch("fractional"),
             "The rubber's polymer chains relax over a broad spectrum of times, which a "
             "fractional derivative of order α captures with two numbers.",
             "Stiffness rises as a power of frequency and the loss factor is nearly constant "
@@ -116,8 +100,10 @@ EFFECTS: dict[str, Effect] = {
         Effect(
             "inertia",
             "Apparent mass seen by the force sensor",
-            (Parameter("mass", "kg", "apparent mass M (a moment of inertia in torsion and conical)",
-                       (1e-12, 1e4), rotation_unit="kg·m²"),),
+            # its unit is the mode's apparent mass' (Mode.mass): kg, kg·m² in the rotations
+            (Parameter("mass", MODE[TRANSLATIONS[0]].mass,
+                       "apparent mass M (a moment of inertia in torsion and conical)", (1e-12, 1e4),
+                       mode_unit="mass"),),
             "Mass between the rubber and the force sensor (fixture, part of the rubber) is "
             "accelerated with the drive; its inertial force adds to the rubber's.",
             "Measured stiffness falls below the model more and more at high frequency, as ω², "
@@ -192,32 +178,6 @@ def split_id(eid: str) -> tuple[str, str | None]:
 def effect_of(eid: str) -> Effect:
     """The library's effect behind an id, mode-tied or not (:func:`split_id`)."""
     return EFFECTS[split_id(eid)[0]]
-
-
-# µ's fitting range, far wider than any rubber (it keeps the search finite); the other
-# parameters carry theirs in the effect library
-SHEAR_MODULUS = Parameter("shear_modulus", "Pa", "shear modulus µ", (1e2, 1e11))
-
-
-def parameter(name: str) -> Parameter:
-    """The fitting range and scale of a parameter: a material name, or ``effect_id.name``."""
-    if name == "shear_modulus":
-        return SHEAR_MODULUS
-    eid, _, pname = name.rpartition(".")
-    base = split_id(eid)[0]
-    owners = [EFFECTS[base]] if base in EFFECTS else [] if eid else [EFFECTS["friction"], EFFECTS["fractional"]]
-    for effect in owners:
-        for p in effect.parameters:
-            if p.name == pname:
-                return p
-    raise ValueError(f"unknown parameter {name!r}")
-
-
-def parameter_unit(name: str, mode: str) -> str:
-    """The unit of a parameter (its fitting name) in a design of ``mode``: a rig effect tied to
-    another mode (``inertia@torsion.mass``) is in that mode's unit."""
-    tied = split_id(name.rpartition(".")[0])[1]
-    return parameter(name).unit_in(tied or mode)
 
 
 def validate_effects(effects: Any) -> dict[str, dict[str, float]]:

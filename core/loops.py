@@ -13,9 +13,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import material as mat
-from .bushing import ROUTES, UNITS, Route, check_strain, positive_values, refuse_structural_effects
+from .bushing import ROUTES, Route, check_strain, positive_values, refuse_structural_effects
 from .design import Design
 from .effects import branch_moduli
+from .parameters import MODE
 
 
 def force_per_stress(design: Design) -> float:
@@ -46,7 +47,7 @@ class LoopResult:
 
     @property
     def units(self) -> dict[str, str]:
-        return UNITS[self.design.mode]
+        return MODE[self.design.mode].units
 
     def table(self) -> dict[str, np.ndarray]:
         return {

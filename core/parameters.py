@@ -4,27 +4,20 @@ Every other list of parameters or modes (the design file's keys, the fit's names
 sensitivities, the tolerances, the explorer's fields and link, the exports' units, the words of
 the diagnosis) is made from these two tables; none is typed out elsewhere.
 
-Design parameters (docs/model.md, "Symbols"):
+Design parameters: docs/model.md's "Symbols and units" shows them (symbol, name, SI unit, the
+unit people read, meaning), and tests/test_parameters.py checks that page against
+:data:`PARAMETERS`. A display value × factor is the SI value. The material's parameters belong
+to the branches of the thesis' model (:data:`BRANCH_PARAMETERS`) and carry the range a fit
+searches (:attr:`DesignParameter.fitting`, a :class:`Parameter` as an effect's parameters are).
 
-====== ========================== ========= ========= ======= ===========================================
-symbol name                       SI unit   display   factor  meaning
-====== ========================== ========= ========= ======= ===========================================
-a      ``inner_radius``           m         mm        1e-3    inner (bonded) radius
-b      ``outer_radius``           m         mm        1e-3    outer (bonded) radius, b > a
-L      ``length``                 m         mm        1e-3    bushing length
-µ      ``shear_modulus``          Pa        MPa       1e6     elastic shear modulus
-m      ``fractional_coefficient`` Pa·s^α    MPa·s^α   1e6     fractional-derivative coefficient
-α      ``fractional_order``       –         –         1       fractional order, 0 < α ≤ 1
-σ_fmax ``friction_stress_max``    Pa        kPa       1e3     largest friction stress
-ε½     ``friction_strain_half``   –         –         1       strain at which half of σ_fmax is built
-====== ========================== ========= ========= ======= ===========================================
-
-A display value × factor is the SI value. Modes: axial and radial are translations (m, N/m,
-shown in mm and kN/mm), torsion and conical rotations (rad, N·m/rad).
+Modes: axial and radial are translations (m, N/m, shown in mm and kN/mm), torsion and conical
+rotations (rad, N·m/rad); axial and torsion act along or about the bushing's axis, radial and
+conical across it.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,10 +41,31 @@ class Unit:
 
 
 @dataclass(frozen=True)
+class Parameter:
+    """What a fit needs of one parameter (the material's or an effect's): its name, SI unit, a
+    few words of meaning, the range searched (SI) and whether it is fitted as its logarithm (a
+    scale) or as itself. A parameter whose unit is its mode's (an apparent mass: kg, kg·m² in
+    the rotations) names the :class:`Mode` field that gives it, ``mode_unit``; its ``unit`` is
+    then the translations'."""
+
+    name: str
+    unit: str
+    meaning: str
+    bounds: tuple[float, float] = (0.0, math.inf)
+    log: bool = True
+    mode_unit: str | None = None  # "mass": its unit is the Mode.mass of the mode at hand
+
+    def unit_in(self, mode: str) -> str:
+        """The parameter's one unit in ``mode`` (a mode's name)."""
+        return getattr(MODE[mode], self.mode_unit) if self.mode_unit else self.unit
+
+
+@dataclass(frozen=True)
 class DesignParameter:
     """One parameter of a design: its key in files and code, where it lives (``geometry`` or
     ``material``), its symbol, units, its key in a link's tolerances (``tol=mu:10``), the label
-    and one-line doc of its field, and the range a fit searches (SI; None: not fitted)."""
+    and one-line doc of its field, the range a fit searches (SI; None: not fitted) and, for the
+    material, the branch of the thesis' model it belongs to (elastic, fractional, friction)."""
 
     name: str
     group: str
@@ -63,6 +77,7 @@ class DesignParameter:
     meaning: str  # a few words for sentences: "shear modulus µ"
     fit_range: tuple[float, float] | None = None
     log: bool = True  # fitted as its logarithm (a scale) or as itself
+    branch: str | None = None  # the material's: the branch of the model (eqs 1, 2, 6) it sizes or shapes
 
     @property
     def field(self) -> str:
@@ -81,6 +96,14 @@ class DesignParameter:
         """The field's label with its display unit: ``Shear modulus µ (MPa)``."""
         return f"{self.label} ({self.unit.display})"
 
+    @property
+    def fitting(self) -> Parameter:
+        """The parameter as a fit sees it (SI unit, meaning, range, scale); ValueError for one no
+        fit varies (the geometry)."""
+        if self.fit_range is None:
+            raise ValueError(f"{self.name} is not fitted")
+        return Parameter(self.name, self.unit.si, self.meaning, self.fit_range, self.log)
+
 
 PARAMETERS: tuple[DesignParameter, ...] = (
     DesignParameter("inner_radius", "geometry", "a", Unit("m", "mm", 1e-3), "a", "Inner radius a",
@@ -92,62 +115,78 @@ PARAMETERS: tuple[DesignParameter, ...] = (
     # µ's fitting range is far wider than any rubber's: it keeps the search finite
     DesignParameter("shear_modulus", "material", "µ", Unit("Pa", "MPa", 1e6), "mu", "Shear modulus µ",
                     "Elastic shear modulus µ: the stiffness that stays at any rate and amplitude.",
-                    "shear modulus µ", (1e2, 1e11)),
+                    "shear modulus µ", (1e2, 1e11), branch="elastic"),
     DesignParameter("fractional_coefficient", "material", "m", Unit("Pa·s^α", "MPa·s^α", 1e6), "m",
                     "Fractional coefficient m", "Fractional coefficient m: size of the frequency dependence.",
-                    "fractional coefficient m", (1e-2, 1e11)),
+                    "fractional coefficient m", (1e-2, 1e11), branch="fractional"),
     DesignParameter("fractional_order", "material", "α", Unit("–", "–"), "alpha", "Fractional order α",
                     "Fractional order α in (0, 1]: how fast stiffness rises with frequency.",
-                    "fractional order α in (0, 1]", (1e-3, 1.0), log=False),
+                    "fractional order α in (0, 1]", (1e-3, 1.0), log=False, branch="fractional"),
     DesignParameter("friction_stress_max", "material", "σ_fmax", Unit("Pa", "kPa", 1e3), "sigma",
                     "Friction stress σ_fmax", "Largest friction stress σ_fmax: size of the amplitude dependence.",
-                    "largest friction stress σ_fmax", (1e-3, 1e9)),
+                    "largest friction stress σ_fmax", (1e-3, 1e9), branch="friction"),
     DesignParameter("friction_strain_half", "material", "ε½", Unit("–", "–"), "eps_half", "Friction strain ε½",
                     "Strain ε½ at which half of σ_fmax is built: where the softening happens.",
-                    "strain ε½ to build half of σ_fmax", (1e-9, 10.0)),
+                    "strain ε½ to build half of σ_fmax", (1e-9, 10.0), branch="friction"),
 )
 BY_NAME = {p.name: p for p in PARAMETERS}
 GEOMETRY = tuple(p.name for p in PARAMETERS if p.group == "geometry")
 MATERIAL = tuple(p.name for p in PARAMETERS if p.group == "material")
 NAMES = GEOMETRY + MATERIAL
+# the material's parameters by branch of the model, in the table's order: elastic (µ),
+# fractional (m, α), friction (σ_fmax, ε½)
+BRANCH_PARAMETERS = {b: tuple(p.name for p in PARAMETERS if p.branch == b)
+                     for b in dict.fromkeys(p.branch for p in PARAMETERS if p.branch)}
 
 
 @dataclass(frozen=True)
 class Mode:
-    """One direction of the bushing: how its sleeves move, and the units of its drive, load,
-    stiffness and apparent mass."""
+    """One direction of the bushing: how its sleeves move (along or about the axis, or across
+    it), and the units of its drive, load, stiffness and apparent mass."""
 
     name: str
     motion: str  # "translation" or "rotation"
     description: str
     drive: str  # what the drive is called: Displacement, Angle, Tilt angle
+    drive_kind: str  # the drive's quantity in results' units: displacement or angle
     load: str  # Force or Moment
     amplitude: Unit
     stiffness: Unit
     force: Unit
     mass: str  # the unit of an apparent mass in this mode: kg or kg·m²
     default_shape: str  # the shape factor used unless a design names one (SHAPES)
+    on_axis: bool  # along or about the bushing's axis (one direction); else across it (two alike)
 
     @property
     def rotation(self) -> bool:
         return self.motion == "rotation"
 
+    @property
+    def units(self) -> dict[str, str]:
+        """The SI units of a result in this mode: amplitude, stiffness, force (or moment) and
+        what the drive is (``displacement`` or ``angle``)."""
+        return {"amplitude": self.amplitude.si, "stiffness": self.stiffness.si, "force": self.force.si,
+                "drive": self.drive_kind}
+
 
 _TRANSLATION = {"amplitude": Unit("m", "mm", 1e-3), "stiffness": Unit("N/m", "kN/mm", 1e6),
-                "force": Unit("N", "N"), "mass": "kg", "load": "Force"}
+                "force": Unit("N", "N"), "mass": "kg", "load": "Force",
+                "drive_kind": "displacement"}
 _ROTATION = {"amplitude": Unit("rad", "rad"), "stiffness": Unit("N·m/rad", "N·m/rad"),
-             "force": Unit("N·m", "N·m"), "mass": "kg·m²", "load": "Moment"}
+             "force": Unit("N·m", "N·m"), "mass": "kg·m²", "load": "Moment",
+             "drive_kind": "angle"}
 
 MODE_TABLE: tuple[Mode, ...] = (
     # axial and torsion: the thesis' closed forms (eqs 17, 18); radial and conical have none that
     # holds at real lengths, so the finite-length table (core.shape)
     Mode("axial", "translation", "the sleeves moved apart along the axis", "Displacement",
-         default_shape="long", **_TRANSLATION),
-    Mode("torsion", "rotation", "the sleeves turned about the axis", "Angle", default_shape="long", **_ROTATION),
-    Mode("radial", "translation", "the sleeves moved apart across the axis", "Displacement",
-         default_shape="finite", **_TRANSLATION),
-    Mode("conical", "rotation", "the sleeves tilted about a diameter", "Tilt angle", default_shape="finite",
+         default_shape="long", on_axis=True, **_TRANSLATION),
+    Mode("torsion", "rotation", "the sleeves turned about the axis", "Angle", default_shape="long", on_axis=True,
          **_ROTATION),
+    Mode("radial", "translation", "the sleeves moved apart across the axis", "Displacement",
+         default_shape="finite", on_axis=False, **_TRANSLATION),
+    Mode("conical", "rotation", "the sleeves tilted about a diameter", "Tilt angle", default_shape="finite",
+         on_axis=False, **_ROTATION),
 )
 MODE = {m.name: m for m in MODE_TABLE}
 MODES = tuple(MODE)
@@ -155,6 +194,8 @@ SHAPES = ("long", "finite")  # closed forms of long bushings, or the finite-leng
 DEFAULT_SHAPE = {m.name: m.default_shape for m in MODE_TABLE}
 TRANSLATIONS = tuple(m.name for m in MODE_TABLE if not m.rotation)  # amplitude in m, stiffness in N/m
 ROTATIONS = tuple(m.name for m in MODE_TABLE if m.rotation)  # amplitude in rad, stiffness in N·m/rad
+# the thesis' own modes, long by default: its closed forms (eqs 17, 18), slices and continuum
+THESIS_MODES = tuple(m.name for m in MODE_TABLE if m.default_shape == "long")
 
 
 def mode(name: str) -> Mode:

@@ -60,7 +60,7 @@ def test_measured_points_appear_over_the_model(app):
 
 def test_dense_data_are_drawn_as_bin_means_with_the_gap_over_every_point(app):
     from app.curves import DISPLAY_POINTS
-    from core.identify.fit import gap
+    from core.residuals import gap
     from core.synthetic import synthetic_loop, synthetic_stiffness
 
     dense = synthetic_stiffness(PAPER_B, np.geomspace(1, 100, 4000), [1e-5, 1e-4, 1e-3], seed=2)

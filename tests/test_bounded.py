@@ -12,11 +12,11 @@ from scipy import stats
 from core import PAPER_B, TABLE_1
 from core.data import read_stiffness
 from core.design import read_design
-from core.effects import parameter_unit
 from core.identify import fit as fit_module
 from core.identify.diagnose import diagnose, summary
 from core.identify.fit import fit_global
 from core.identify.uncertainty import SIDE_EVALUATIONS, minimise, profile
+from core.registry import parameter_unit
 from core.synthetic import synthetic_stiffness
 from core.whatif import target as target_module
 

@@ -13,8 +13,10 @@ from cli.commands import Progress
 from core import PAPER_B, stiffness_points
 from core.data import MeasuredStiffness
 from core.identify.diagnose import diagnose
-from core.identify.fit import fit_global, folded, gap, parameter_values
+from core.identify.fit import fit_global, folded
 from core.loops import loop_force
+from core.registry import parameter_values
+from core.residuals import gap
 from core.synthetic import synthetic_loop, synthetic_stiffness
 
 AMPLITUDES = [0.013e-3, 0.04e-3, 0.1e-3, 0.17e-3, 0.35e-3]

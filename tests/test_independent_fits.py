@@ -12,7 +12,10 @@ from core import PAPER_B, TABLE_1, strain_factor
 from core.bushing import stiffness_points
 from core.data import MeasuredStiffness
 from core.identify.diagnose import BIC_THRESHOLD, diagnose
-from core.identify.fit import PARAMETERS, fit_global, gap, parameter, parameter_values
+from core.identify.fit import fit_global
+from core.parameters import MATERIAL as PARAMETERS
+from core.registry import parameter, parameter_values
+from core.residuals import gap
 from core.whatif.sensitivity import value_of
 from tests.test_material import _berg_loop_harmonic, reference_modulus
 from tests.test_shape import TABLE_ACCURACY, energy_strain_factor, fe_paper_b

@@ -10,7 +10,8 @@ import pytest
 from cli.main import main
 from core import PAPER_B, write_design
 from core.data import DataError, MeasuredStiffness, combined, parse_stiffness
-from core.identify.fit import fit_global, model_stiffness, parameter_values, predicted, selection
+from core.identify.fit import fit_global, model_stiffness, predicted, selection
+from core.registry import parameter_values
 from core.synthetic import synthetic_stiffness
 
 NOISE = 0.005

@@ -193,7 +193,8 @@ def test_bushing_card_on_the_command_line(tmp_path, capsys):
 def test_a_radial_measurement_identifies_the_material():
     """Synthetic radial data (five displacements, 0.5 % noise): the fit in radial mode recovers
     the five parameters within its intervals; the same material predicts the axial card."""
-    from core.identify.fit import fit_global, parameter_values
+    from core.identify.fit import fit_global
+    from core.registry import parameter_values
     from core.synthetic import synthetic_stiffness
 
     truth = PAPER_B.replace(mode="radial")

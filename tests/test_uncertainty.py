@@ -14,8 +14,9 @@ from scipy import stats
 from core import PAPER_B
 from core.data import read_stiffness
 from core.design import read_design
-from core.identify.fit import fit_global, parameter_values
+from core.identify.fit import fit_global
 from core.identify.uncertainty import profile
+from core.registry import parameter_values
 from core.synthetic import synthetic_stiffness
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"

@@ -14,7 +14,9 @@ from cli.main import main
 from core import PAPER_B, TABLE_1, stiffness, write_design
 from core.bushing import MAX_STRAIN, stiffness_points
 from core.data import loss_factor
-from core.identify.fit import PARAMETERS, fit_global, parameter
+from core.identify.fit import fit_global
+from core.parameters import MATERIAL as PARAMETERS
+from core.registry import parameter
 from core.synthetic import synthetic_stiffness
 from core.whatif.sensitivity import elasticities, log_derivatives, sentence, value_of
 from core.whatif.target import TargetError, problem_from_dict, solve

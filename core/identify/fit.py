@@ -34,44 +34,16 @@ import numpy as np
 from ..bushing import check_measured_amplitude, stiffness_points
 from ..data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from ..design import Design, as_dict
-from ..effects import Parameter, parameter, parameter_unit
 from ..loops import loop_force
+from ..parameters import BRANCH_PARAMETERS, MATERIAL, Parameter
+from ..registry import parameter, parameter_unit, parameter_values, with_values
+from ..residuals import gap, gaps_by_mode, relative_residual
 from ..shape import OutsideTable
 from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS, linearised, minimise, profile
 
-PARAMETERS = (
-    "shear_modulus",
-    "fractional_coefficient",
-    "fractional_order",
-    "friction_stress_max",
-    "friction_strain_half",
-)
 FIT_NFEV = (100, 100, 200)  # iterations from one start in the stages of uncertainty.minimise
 # a relative misfit beyond this is no fit, and its squares would overflow: not evaluable
 MAX_RESIDUAL = 1e100
-
-
-def parameter_values(design: Design) -> dict[str, float]:
-    """Every parameter of a design by its fitting name: the material's, then ``effect.name``."""
-    values = as_dict(design.material)
-    for eid, params in design.effects:
-        values.update({f"{eid}.{p}": v for p, v in params})
-    return values
-
-
-def with_values(design: Design, values: dict[str, float]) -> Design:
-    """``design`` with parameters (fitting names, as :func:`parameter_values`) replaced. The
-    effects are rebuilt (and validated) only when an effect parameter is among them: this runs
-    at every residual evaluation of a fit."""
-    changes: dict = {k: v for k, v in values.items() if "." not in k}
-    if len(changes) < len(values):
-        effects = design.every_effect
-        for k, v in values.items():
-            if "." in k:
-                eid, _, p = k.rpartition(".")
-                effects.setdefault(eid, {})[p] = v
-        changes["effects"] = effects
-    return design.replace(**changes)
 
 
 def model_stiffness(design: Design, data: MeasuredStiffness) -> np.ndarray:
@@ -98,15 +70,6 @@ def check_data_amplitudes(design: Design, data: MeasuredStiffness) -> None:
             raise ValueError(f"the data's {mode} rows: {exc}") from None
 
 
-def gaps_by_mode(k: np.ndarray, data: MeasuredStiffness) -> dict[str, float]:
-    """The gap of each mode's rows of the model's K at ``data`` (empty without a `mode` column)."""
-    if data.mode is None:
-        return {}
-    return {m: gap(k[data.mode == m], data.stiffness[data.mode == m],
-                   None if data.count is None else data.count[data.mode == m])
-            for m in np.unique(data.mode.astype(str))}
-
-
 def folded(phase: np.ndarray, values: np.ndarray, bins: int):
     """A steady periodic record folded onto one period: the mean phase (in [0, 2π)) and value in
     each of ``bins`` equal phase bins that holds samples, and their counts; the record itself
@@ -118,18 +81,6 @@ def folded(phase: np.ndarray, values: np.ndarray, bins: int):
                          return_inverse=True)
     count = np.bincount(label).astype(float)
     return (np.bincount(label, weights=wrapped) / count, np.bincount(label, weights=values) / count, count)
-
-
-def relative_residual(model: np.ndarray, data: np.ndarray) -> np.ndarray:
-    """(K_model − K_data) / |K_data|: complex, one per point (the gap's terms, what fits minimise)."""
-    return (model - data) / np.abs(data)
-
-
-def gap(model: np.ndarray, data: np.ndarray, count: np.ndarray | None = None) -> float:
-    """docs/files.md's gap: sqrt(mean(|K_model − K_data|² / |K_data|²)); over binned data
-    (``count`` points per entry) the mean counts each entry ``count`` times."""
-    square = np.abs(relative_residual(model, data)) ** 2
-    return float(np.sqrt(np.average(square, weights=count)))
 
 
 @dataclass(frozen=True)
@@ -399,7 +350,7 @@ def _result(problem: _Problem, sol, method: str, starts: int, design: Design, in
 
 
 def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: MeasuredLoop | None = None,
-               *, starts: int = 8, free: tuple[str, ...] = PARAMETERS, seed: int = 0,
+               *, starts: int = 8, free: tuple[str, ...] = MATERIAL, seed: int = 0,
                initial: Sequence[Mapping[str, float]] = (), intervals: bool = True) -> FitResult:
     """Fit the parameters ``free`` of ``design`` to all the data at once.
 
@@ -485,10 +436,10 @@ def fit_two_step(design: Design, loop: MeasuredLoop, sweep: MeasuredStiffness,
     along the strong µ–m correlation), which is the point the alternation converges to."""
     current = design
     history = []
+    on_loop = BRANCH_PARAMETERS["elastic"] + BRANCH_PARAMETERS["friction"]  # µ, σ_fmax, ε½
     for _ in range(rounds):
-        step1 = fit_global(current, loop=loop, free=("shear_modulus", "friction_stress_max",
-                                                      "friction_strain_half"), starts=4, intervals=False)
-        step2 = fit_global(step1.design, data=sweep, free=("fractional_coefficient", "fractional_order"),
+        step1 = fit_global(current, loop=loop, free=on_loop, starts=4, intervals=False)
+        step2 = fit_global(step1.design, data=sweep, free=BRANCH_PARAMETERS["fractional"],
                            starts=4, intervals=False)
         current = step2.design
         history.append(as_dict(current.material))

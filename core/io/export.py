@@ -23,10 +23,11 @@ import math
 
 import numpy as np
 
-from ..bushing import UNITS, stiffness_points
+from ..bushing import stiffness_points
 from ..card import CARD_MODES, card_design
 from ..data import csv_text, loss_factor
 from ..design import Design
+from ..parameters import MODE, ROTATIONS, TRANSLATIONS
 
 MAX_EXPORT_POINTS = 100_000  # frequencies × amplitudes of one export
 
@@ -64,11 +65,11 @@ def table_csv(grid: dict) -> str:
                 cols["mode"].append(mode)
                 cols["frequency_hz"].append(f)
                 cols["amplitude"].append(amp)
-                cols["amplitude_unit"].append(UNITS[mode]["amplitude"])
+                cols["amplitude_unit"].append(MODE[mode].amplitude.si)
                 cols["stiffness_real"].append(k[i, j].real)
                 cols["stiffness_imag"].append(k[i, j].imag)
                 cols["magnitude"].append(abs(k[i, j]))
-                cols["stiffness_unit"].append(UNITS[mode]["stiffness"])
+                cols["stiffness_unit"].append(MODE[mode].stiffness.si)
                 cols["loss_factor"].append(eta[i, j])
     return csv_text(cols)
 
@@ -86,7 +87,7 @@ def table_json(grid: dict, design: Design) -> str:
     for mode in CARD_MODES:
         k = grid[mode]["stiffness"]
         out["directions"][mode] = {
-            "amplitude_unit": UNITS[mode]["amplitude"], "stiffness_unit": UNITS[mode]["stiffness"],
+            "amplitude_unit": MODE[mode].amplitude.si, "stiffness_unit": MODE[mode].stiffness.si,
             "amplitude": grid[mode]["amplitude"].tolist(), "stiffness_real": k.real.tolist(),
             "stiffness_imag": k.imag.tolist(), "magnitude": np.abs(k).tolist(), "loss_factor": loss_factor(k).tolist(),
         }
@@ -95,7 +96,17 @@ def table_json(grid: dict, design: Design) -> str:
 
 # ---- Nastran -------------------------------------------------------------------------------------
 
-NASTRAN_DOF = ("axial", "radial", "radial", "torsion", "conical", "conical")  # K1 … K6, element x = axis
+# K1 … K6: the translations along x, y, z, then the rotations about them; element x is the
+# bushing axis, so x takes the mode along (about) the axis, y and z the one across it
+NASTRAN_DOF = tuple(m for group in (TRANSLATIONS, ROTATIONS)
+                    for m in sorted(group, key=lambda m: not MODE[m].on_axis)
+                    for _ in range(1 if MODE[m].on_axis else 2))
+
+
+def _dof_words() -> str:
+    """Which mode each of K1 … K6 holds, in words: ``K1 axial, K2 = K3 radial, …``."""
+    return ", ".join(" = ".join(f"K{i + 1}" for i, d in enumerate(NASTRAN_DOF) if d == m) + f" {m}"
+                     for m in dict.fromkeys(NASTRAN_DOF))
 
 
 def nastran_real(value: float) -> str:
@@ -131,11 +142,11 @@ def nastran(grid: dict, design: Design, first_id: int = 1) -> str:
     f = grid["frequency_hz"]
     n_amp = grid[CARD_MODES[0]]["amplitude"].size
     lines = [f"$ Bushing Explorer: {design.name or 'design'}; element x along the bushing axis",
-             "$ K1 axial, K2 = K3 radial, K4 torsion, K5 = K6 conical; GE = loss factor; SI units (N, m, rad)"]
+             f"$ {_dof_words()}; GE = loss factor; SI units (N, m, rad)"]
     for i in range(n_amp):
         pid = first_id + i
         k = {m: grid[m]["stiffness"][i] for m in CARD_MODES}
-        amps = ", ".join(f"{m} {grid[m]['amplitude'][i]:.4g} {UNITS[m]['amplitude']}" for m in CARD_MODES)
+        amps = ", ".join(f"{m} {grid[m]['amplitude'][i]:.4g} {MODE[m].amplitude.si}" for m in CARD_MODES)
         lines.append(f"$ PID {pid}: equivalent strain {grid['strain'][i]:.4g} ({amps})")
         lines += _card("PBUSH", [str(pid), "K", *(nastran_real(k[m][0].real) for m in NASTRAN_DOF)])
         lines += _card("", ["", "GE", *(nastran_real(loss_factor(k[m][0])) for m in NASTRAN_DOF)])
@@ -153,9 +164,14 @@ def nastran(grid: dict, design: Design, first_id: int = 1) -> str:
 
 # ---- Adams ----------------------------------------------------------------------------------------
 
-ADAMS_AXES = {"axial": ("Z_FORCE_CURVE", "Z_DAMPING"), "radial": ("X_FORCE_CURVE", "X_DAMPING"),
-              "torsion": ("Z_TORQUE_CURVE", "RZ_DAMPING"), "conical": ("X_TORQUE_CURVE", "RX_DAMPING")}
-ADAMS_ALSO = {"radial": ("Y_FORCE_CURVE", "Y_DAMPING"), "conical": ("Y_TORQUE_CURVE", "RY_DAMPING")}
+
+def adams_sections(mode: str) -> tuple[tuple[str, str], ...]:
+    """The (curve, damping) sections of ``mode`` in a TeimOrbit file, whose z is the bushing
+    axis: a mode along (about) the axis has z's, one across it x's and y's alike."""
+    m = MODE[mode]
+    what, damping = ("TORQUE", "R") if m.rotation else ("FORCE", "")
+    axes = ("Z",) if m.on_axis else ("X", "Y")
+    return tuple((f"{axis}_{what}_CURVE", f"{damping}{axis}_DAMPING") for axis in axes)
 
 
 def adams(grid: dict, design: Design, points: int = 5) -> str:
@@ -176,9 +192,9 @@ def adams(grid: dict, design: Design, points: int = 5) -> str:
         k = grid[mode]["stiffness"][0, 0]
         amp = float(grid[mode]["amplitude"][0])
         x = np.linspace(-amp, amp, points)
-        for curve, damping in (ADAMS_AXES[mode], *((ADAMS_ALSO[mode],) if mode in ADAMS_ALSO else ())):
+        for curve, damping in adams_sections(mode):
             what = "torque" if "TORQUE" in curve else "force"
-            lines += [f"$ {mode}: K' = {k.real:.8g} {UNITS[mode]['stiffness']}, loss factor {loss_factor(k):.6g}",
+            lines += [f"$ {mode}: K' = {k.real:.8g} {MODE[mode].stiffness.si}, loss factor {loss_factor(k):.6g}",
                       f"[{curve}]", f"{{ {'rot' if what == 'torque' else 'disp'} {what} }}"]
             lines += [f"{xi:.10g} {k.real * xi:.10g}" for xi in x]
             lines += [f"[{damping}]", f"DAMPING = {k.imag / omega:.10g}"]

@@ -19,23 +19,17 @@ import numpy as np
 from ..bushing import stiffness_points
 from ..data import loss_factor
 from ..design import Design
-from ..identify.fit import PARAMETERS as MATERIAL_PARAMETERS
+from ..parameters import BY_NAME, NAMES
 
-GEOMETRY_PARAMETERS = ("inner_radius", "outer_radius", "length")
-SENSITIVITY_PARAMETERS = GEOMETRY_PARAMETERS + MATERIAL_PARAMETERS
 STEP = 1e-4  # the step in ln p of the central differences
-SYMBOLS = {"inner_radius": "a", "outer_radius": "b", "length": "L", "shear_modulus": "µ",
-           "fractional_coefficient": "m", "fractional_order": "α", "friction_stress_max": "σ_fmax",
-           "friction_strain_half": "ε½"}
 
 
 def value_of(design: Design, name: str) -> float:
-    """A geometric or material parameter of ``design`` by name."""
-    owner = design.geometry if name in GEOMETRY_PARAMETERS else design.material
-    return float(getattr(owner, name))
+    """A geometric or material parameter of ``design`` by name (SI)."""
+    return float(getattr(getattr(design, BY_NAME[name].group), name))
 
 
-def log_derivatives(design: Design, frequency_hz, amplitude, names=SENSITIVITY_PARAMETERS,
+def log_derivatives(design: Design, frequency_hz, amplitude, names=NAMES,
                     step: float = STEP, **kwargs) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """∂|K|/∂ln p and ∂η/∂ln p of every parameter in ``names`` at the points (``frequency_hz``,
     ``amplitude``, broadcast), by central differences in ln p (one-sided where a step leaves the
@@ -59,7 +53,7 @@ def log_derivatives(design: Design, frequency_hz, amplitude, names=SENSITIVITY_P
 
 
 def elasticities(design: Design, frequency_hz: float, amplitude: float,
-                 names=SENSITIVITY_PARAMETERS) -> dict[str, dict[str, float]]:
+                 names=NAMES) -> dict[str, dict[str, float]]:
     """At one operating point: for every parameter, ``magnitude`` ∂ln|K|/∂ln p and
     ``loss_factor`` ∂η/∂ln p."""
     k = complex(stiffness_points(design, frequency_hz, amplitude))
@@ -76,6 +70,7 @@ def sentence(values: dict[str, dict[str, float]]) -> str:
     """What dominates, in one sentence."""
     (k1, e1), (k2, e2) = ranked(values, "magnitude")[:2]
     (l1, d1) = ranked(values, "loss_factor")[0]
-    return (f"|K| follows {SYMBOLS[k1]} most (+1 % in {SYMBOLS[k1]} gives {e1:+.2f} % in |K|), then "
-            f"{SYMBOLS[k2]} ({e2:+.2f} %); the loss factor follows {SYMBOLS[l1]} most "
-            f"(+1 % in {SYMBOLS[l1]} moves it by {d1 / 100:+.2g}).")
+    s1, s2, s3 = (BY_NAME[n].symbol for n in (k1, k2, l1))
+    return (f"|K| follows {s1} most (+1 % in {s1} gives {e1:+.2f} % in |K|), then "
+            f"{s2} ({e2:+.2f} %); the loss factor follows {s3} most "
+            f"(+1 % in {s3} moves it by {d1 / 100:+.2g}).")

@@ -30,14 +30,15 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares, minimize
 
-from ..bushing import MAX_STRAIN, UNITS, stiffness_points
+from ..bushing import MAX_STRAIN, stiffness_points
 from ..data import loss_factor
-from ..design import MODES, SIZE_RANGE, Design, DesignError, design_from_dict, strict_json
-from ..identify.fit import PARAMETERS as MATERIAL_PARAMETERS
-from ..identify.fit import parameter
+from ..design import SIZE_RANGE, Design, DesignError, design_from_dict, strict_json
+from ..parameters import GEOMETRY, MATERIAL, MODE, MODES
+from ..registry import parameter
 
 QUANTITIES = ("magnitude", "loss_factor")
-GEOMETRY_LIMITS = ("inner_radius", "outer_radius", "length", "thickness")
+GEOMETRY_LIMITS = (*GEOMETRY, "thickness")  # a, b, L and the rubber's thickness b − a
+SEARCHED = tuple("thickness" if n == "outer_radius" else n for n in GEOMETRY)  # a, t = b − a, L
 DEFAULT_LIMITS = {"inner_radius": (1e-3, 1.0), "outer_radius": (2e-3, 1.0), "length": (1e-3, 1.0),
                   "thickness": (1e-3, 1.0)}
 TOLERANCE = 0.01  # a numeric target is met within ±1 % unless the file says otherwise
@@ -87,10 +88,10 @@ class Target:
         return abs(k[0]) if self.quantity == "magnitude" else float(loss_factor(k[0]))
 
     def describe(self) -> str:
-        amp = " and ".join(f"{x:.4g} {UNITS[m]['amplitude']}" for m, x in zip(self.modes, self.amplitudes))
+        amp = " and ".join(f"{x:.4g} {MODE[m].amplitude.si}" for m, x in zip(self.modes, self.amplitudes))
         what = (f"|K_{self.modes[0]}|/|K_{self.modes[1]}|" if self.is_ratio else
                 f"{self.modes[0]} {'|K|' if self.quantity == 'magnitude' else 'loss factor'}")
-        unit = "" if self.is_ratio or self.quantity == "loss_factor" else f" {UNITS[self.modes[0]]['stiffness']}"
+        unit = "" if self.is_ratio or self.quantity == "loss_factor" else f" {MODE[self.modes[0]].stiffness.si}"
         if self.value is not None:
             goal = f"= {self.value:.4g}{unit}"
         else:
@@ -122,7 +123,7 @@ class Problem:
 
     @property
     def variables(self) -> tuple[str, ...]:
-        geo = tuple(n for n in ("inner_radius", "thickness", "length") if n not in self.fixed)
+        geo = tuple(n for n in SEARCHED if n not in self.fixed)
         return geo + tuple(self.free_material)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
@@ -131,7 +132,7 @@ class Problem:
 
     def values(self, start: Design) -> dict[str, float]:
         g, m = start.geometry, start.material
-        out = {"inner_radius": g.inner_radius, "thickness": g.outer_radius - g.inner_radius, "length": g.length}
+        out = {n: g.outer_radius - g.inner_radius if n == "thickness" else getattr(g, n) for n in SEARCHED}
         out.update({n: getattr(m, n) for n in self.free_material})
         return out
 
@@ -436,7 +437,7 @@ def _target(i: int, spec: Any, tolerance: float, start: Design) -> Target:
         amps = [_number(f"{key}.amplitudes[{j}]", a) for j, a in enumerate(amps)]
     else:
         amps = [_number(f"{key}.amplitude", spec.get("amplitude"))] * len(modes)
-    if len(modes) == 2 and "amplitudes" not in spec and UNITS[modes[0]]["amplitude"] != UNITS[modes[1]]["amplitude"]:
+    if len(modes) == 2 and "amplitudes" not in spec and MODE[modes[0]].amplitude.si != MODE[modes[1]].amplitude.si:
         raise TargetError(f"{key}: {modes[0]} and {modes[1]} are driven in different units: give amplitudes, one per mode")
     quantities = [q for q in QUANTITIES if q in spec]
     if len(quantities) != 1 or (len(modes) == 2 and quantities != ["magnitude"]):
@@ -486,10 +487,10 @@ def problem_from_dict(data: Any) -> Problem:
             raise TargetError(f"limits.{name}: min < max, both within {SIZE_RANGE[0]:g}–{SIZE_RANGE[1]:g} m")
         limits[name] = (low, high)
     fixed = data.get("fixed", [])
-    if not isinstance(fixed, list) or any(n not in ("inner_radius", "thickness", "length") for n in fixed):
-        raise TargetError("fixed: a list of inner_radius, thickness, length (held at the start design's)")
+    if not isinstance(fixed, list) or any(n not in SEARCHED for n in fixed):
+        raise TargetError(f"fixed: a list of {', '.join(SEARCHED)} (held at the start design's)")
     free = {}
-    for name, (low, high) in _ranges("free_material", data.get("free_material", {}), MATERIAL_PARAMETERS).items():
+    for name, (low, high) in _ranges("free_material", data.get("free_material", {}), MATERIAL).items():
         p_lo, p_hi = parameter(name).bounds  # within the fitting range (α also ≤ 1)
         low, high = max(low or p_lo, p_lo, 1e-30), min(high or p_hi, p_hi, 1.0 if name == "fractional_order" else math.inf)
         if not low < high:

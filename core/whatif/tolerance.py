@@ -40,10 +40,11 @@ from ..bushing import (
 )
 from ..data import loss_factor
 from ..design import Design, DesignError, Geometry, strict_json
-from ..identify.fit import FitResult, parameter
+from ..identify.fit import FitResult
 from ..material import equivalent_modulus
-from ..parameters import GEOMETRY, MATERIAL
-from .sensitivity import SENSITIVITY_PARAMETERS, log_derivatives, value_of
+from ..parameters import GEOMETRY, MATERIAL, NAMES
+from ..registry import parameter
+from .sensitivity import log_derivatives, value_of
 
 DISTRIBUTIONS = ("uniform", "normal")
 SAMPLES = 500  # the default sample count
@@ -84,7 +85,7 @@ class FitCovariance:
 
     def matrix(self, design: Design) -> tuple[tuple[str, ...], np.ndarray]:
         """The material parameters and their covariance in the fit's coordinates."""
-        names = tuple(n for n in self.standard_errors if n in SENSITIVITY_PARAMETERS)
+        names = tuple(n for n in self.standard_errors if n in NAMES)
         vague = [n for n in names if not _finite(self.standard_errors[n])]
         if vague:
             raise ToleranceError(f"fit_covariance: the fit does not determine {', '.join(vague)} (no standard error): "
@@ -114,7 +115,7 @@ def _finite(v) -> bool:
 @dataclass(frozen=True)
 class Tolerances:
     """Tolerances of a design's parameters: ``relative`` (a fraction of the value) or
-    ``absolute`` (SI units) half-widths by parameter name (:data:`SENSITIVITY_PARAMETERS`), the
+    ``absolute`` (SI units) half-widths by parameter name (:data:`NAMES`), the
     ``distribution`` of the draws, their number and seed, the band's ``percentiles``, and
     optionally a fit's ``covariance`` for the material."""
 
@@ -129,8 +130,8 @@ class Tolerances:
     def __post_init__(self):
         for kind, values in (("relative", self.relative), ("absolute", self.absolute)):
             for name, h in values.items():
-                if name not in SENSITIVITY_PARAMETERS:
-                    raise ToleranceError(f"tolerances.{name}: unknown parameter (known: {', '.join(SENSITIVITY_PARAMETERS)})")
+                if name not in NAMES:
+                    raise ToleranceError(f"tolerances.{name}: unknown parameter (known: {', '.join(NAMES)})")
                 if not _finite(h) or h < 0:
                     raise ToleranceError(f"tolerances.{name}: must be a number ≥ 0, got {str(h)[:40]}")
                 if kind == "relative" and h >= MAX_RELATIVE:

@@ -8,16 +8,13 @@ from dataclasses import dataclass
 
 from ...design import Design
 from ...effects import EFFECTS, effect_of, split_id
-from ..fit import with_values
+from ...parameters import BRANCH_PARAMETERS, BY_NAME
+from ...registry import with_values
 
-BRANCHES = ("elastic", "fractional", "friction")
-BRANCH_PARAMETERS = {
-    "elastic": ("shear_modulus",),
-    "fractional": ("fractional_coefficient", "fractional_order"),
-    "friction": ("friction_stress_max", "friction_strain_half"),
-}
-# a branch switched off: its modulus 1e-30 Pa, thirty orders below any rubber's
-OFF = {"shear_modulus": 1e-30, "fractional_coefficient": 1e-30, "friction_stress_max": 1e-30}
+BRANCHES = tuple(BRANCH_PARAMETERS)  # elastic, fractional, friction
+# a branch switched off: its modulus (its parameter in Pa) 1e-30 Pa, thirty orders below any rubber's
+OFF = {name: 1e-30 for names in BRANCH_PARAMETERS.values() for name in names
+       if BY_NAME[name].unit.si.startswith("Pa")}
 
 
 @dataclass(frozen=True)

@@ -13,15 +13,9 @@ from ...data import MAX_FIT_POINTS, MeasuredStiffness
 from ...design import Design
 from ...effects import effect_of, split_id
 from ...material import ConvergenceError
-from ..fit import (
-    fit_global,
-    gap,
-    gaps_by_mode,
-    model_stiffness,
-    parameter,
-    parameter_values,
-    relative_residual,
-)
+from ...registry import parameter, parameter_values
+from ...residuals import gap, gaps_by_mode, relative_residual
+from ..fit import fit_global, model_stiffness
 from .model import BRANCHES, Model, baseline_model, candidates, fitting_names
 from .report import Diagnosis, Fitted, Step
 from .statistics import (

@@ -8,6 +8,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ...data import MeasuredStiffness, loss_factor, magnitude_residual_pct
+from ...parameters import MODE
 
 
 def _bins(values: np.ndarray, most: int = 8) -> tuple[np.ndarray, list[tuple[float, float]]]:
@@ -30,9 +31,10 @@ def _fmt_freq(f: float) -> str:
 
 
 def _amplitude_formatter(mode: str) -> Callable[[float], str]:
-    if mode in ("axial", "radial"):
-        return lambda x: f"{x * 1e3:.3g} mm"
-    return lambda x: f"{x:.3g} rad"
+    """An amplitude (SI) of ``mode`` in the unit people read: mm, or rad."""
+    unit = MODE[mode].amplitude
+    per_si = 1.0 / unit.factor  # display units per SI unit, 1000 mm per m: exact, as x / 1e-3 is not
+    return lambda x: f"{x * per_si:.3g} {unit.display}"
 
 
 def _growth(centres: np.ndarray, means: np.ndarray, what: str) -> str:
