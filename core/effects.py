@@ -23,7 +23,8 @@ import numpy as np
 from scipy import special
 
 from .design import DesignError, Material, _number
-from .material import REFERENCE_FREQUENCY_HZ, fractional_modulus, friction_modulus
+from .material import REFERENCE_FREQUENCY_HZ
+from .material import branch_moduli as material_branch_moduli
 from .parameters import BRANCH_PARAMETERS, BY_NAME, MODE, MODES, TRANSLATIONS, Parameter
 
 
@@ -240,11 +241,7 @@ def branch_moduli(material: Material, effects: Mapping, frequency_hz, strain_amp
     f = np.asarray(frequency_hz, dtype=float)
     eps = np.asarray(strain_amplitude, dtype=float)
     zeros = np.zeros(np.broadcast_shapes(f.shape, eps.shape), dtype=complex)
-    base = {
-        "elastic": material.shear_modulus + zeros,
-        "viscoelastic": fractional_modulus(f, material.fractional_coefficient, material.fractional_order) + zeros,
-        "friction": friction_modulus(eps, material.friction_stress_max, material.friction_strain_half) + zeros,
-    }
+    base = {name: value + zeros for name, value in material_branch_moduli(material, f, eps).items()}
     out = dict(base)
     for eid, params in effects.items():
         term = EFFECTS[eid].term

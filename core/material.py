@@ -104,15 +104,22 @@ def equivalent_modulus(material: Material, frequency_hz, strain_amplitude):
     ``material`` is a :class:`Material`, or any object with its five fields as arrays that
     broadcast with the two arguments (e.g. one value per Monte Carlo sample, shaped (n, 1, …),
     as :mod:`core.whatif.tolerance` gives): the result then has a row per sample."""
-    return (  # eq 16: the linear part µ + m(iω)^α/2 is eqs 8–9's µ(ω), the friction part eq 6's
-        material.shear_modulus
-        + fractional_modulus(
-            frequency_hz, material.fractional_coefficient, material.fractional_order
-        )
-        + friction_modulus(
-            strain_amplitude, material.friction_stress_max, material.friction_strain_half
-        )
-    )
+    parts = branch_moduli(material, frequency_hz, strain_amplitude)
+    return parts["elastic"] + parts["viscoelastic"] + parts["friction"]  # eq 16
+
+
+def branch_moduli(material: Material, frequency_hz, strain_amplitude) -> dict:
+    """The three terms of µ_eq (eq 16) in Pa, by branch: ``elastic`` µ, ``viscoelastic``
+    m (iω)^α / 2 and ``friction`` µ_f(ε̂), unbroadcast (µ stays a scalar, or an array of samples).
+    :func:`equivalent_modulus` is their sum; :func:`core.effects.branch_moduli` adds the
+    material-level effects' terms to them."""
+    return {  # the linear part µ + m(iω)^α/2 is eqs 8–9's µ(ω), the friction part eq 6's
+        "elastic": material.shear_modulus,
+        "viscoelastic": fractional_modulus(frequency_hz, material.fractional_coefficient,
+                                           material.fractional_order),
+        "friction": friction_modulus(strain_amplitude, material.friction_stress_max,
+                                     material.friction_strain_half),
+    }
 
 
 # --------------------------------------------------------------------------------------------
