@@ -42,8 +42,21 @@ def sweep_label(value, unit) -> str:
 
 
 def dimensions(mode: str) -> dict[str, hv.Dimension]:
-    """The plotted quantities of ``mode`` with their names, labels and units (the display units
-    of :mod:`core.parameters`)."""
+    """The plotted quantities of ``mode`` with their names, labels and units.
+
+    Parameters
+    ----------
+    mode : str
+        One of :data:`core.parameters.MODES`.
+
+    Returns
+    -------
+    dict of str to holoviews.Dimension
+        A fresh dimension per quantity, in the display units of :mod:`core.parameters`:
+        frequency in Hz; amplitude and drive in mm (axial, radial) or rad (torsion, conical);
+        |K| and Re K in kN/mm or N·m/rad; force in N or N·m; differences and |K| residuals
+        in %; loss factors, gaps and scaled drive and force dimensionless.
+    """
     m = mode_of(mode)
     amp, stiff, force = m.amplitude.display, m.stiffness.display, m.force.display
     return {

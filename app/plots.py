@@ -49,6 +49,11 @@ from .elements import (
 from .misfit_plots import diagnosis_overlays, residual_overlays
 from .units import ROTATION, TRANSLATION
 
+# the public plotting API: the design functions the README and examples/plotting_api.ipynb call,
+# and the dimensions they draw on; the element builders serve the app's tabs
+__all__ = ["branch_plots", "card_plots", "diagnosis_plots", "dimensions", "explorer_plots",
+           "residual_plots", "slices_plots"]
+
 BRANCH_COLORS = {"elastic": "#1f77b4", "viscoelastic": "#2ca02c", "friction": "#d62728"}
 REFERENCE_STYLE = {"color": "#444444", "line_dash": "dashed", "line_width": 2}
 MEASURED_STYLE = {"color": "#222222", "alpha": 0.6, "size": 5}
@@ -163,10 +168,36 @@ def explorer_overlays(data: curves.ExplorerData, dims: dict | None = None, sweep
 
 def explorer_plots(design: Design, frequency_hz: float = 10.0, amplitude: float | None = None, *,
                    width: int | None = 600, **kwargs) -> hv.Layout:
-    """The explorer's five plots of ``design`` at the operating point (``amplitude`` in mm or
-    rad; by default mid-way through the Fletcher–Gent range): the loop, then |K| and the loss
-    factor against frequency and amplitude, each ``width`` pixels wide (None: as wide as their
-    container). ``kwargs`` as :func:`app.curves.explorer_data`."""
+    """The explorer's five plots of ``design`` at an operating point.
+
+    The hysteresis loop, then |K| and the loss factor against frequency and against amplitude.
+    The design is SI (m, Pa); the plots and ``amplitude`` are in the display units of
+    :mod:`app.units`.
+
+    Parameters
+    ----------
+    design : Design
+        The bushing, in SI units.
+    frequency_hz : float, default 10.0
+        The operating frequency in Hz.
+    amplitude : float or None, default None
+        The operating amplitude in display units: mm (axial, radial) or rad (torsion,
+        conical); None: mid-way through the Fletcher–Gent range.
+    width : int or None, default 600
+        The width of each plot in pixels; None: as wide as its container.
+    **kwargs
+        As :func:`app.curves.explorer_data`: ``freq_range`` (Hz), ``reference`` (a Design),
+        ``measured`` (a MeasuredStiffness, SI: Hz, m or rad, N/m or N·m/rad), ``measured_loop``
+        (a MeasuredLoop, SI: s, m or rad, N or N·m), ``n_freq`` and ``n_amp`` (point counts),
+        ``bands`` (tolerance bands in display units).
+
+    Returns
+    -------
+    holoviews.Layout
+        Five plots in two columns: the loop (drive in mm or rad, force in N or N·m), and |K|
+        (kN/mm or N·m/rad) and the loss factor (dimensionless) against frequency (Hz) and
+        amplitude (mm or rad).
+    """
     if amplitude is None:
         amplitude = float(curves.fletcher_gent_amplitudes(design)[2])
     overlays = explorer_overlays(curves.explorer_data(design, frequency_hz, amplitude, **kwargs))
@@ -196,7 +227,28 @@ def slices_overlays(data: dict, dims: dict, at: float) -> dict:
 
 def slices_plots(design: Design, frequency_hz: float = 10.0, amplitude: float | None = None, n: int = 60, *,
                  width: int | None = 800) -> hv.Layout:
-    """One equivalent modulus against 2 and 3 slices and the continuum, at ``frequency_hz``."""
+    """One equivalent modulus against 2 and 3 slices and the continuum (Paper A), at one frequency.
+
+    Parameters
+    ----------
+    design : Design
+        The bushing, in SI units; its stiffness-level effects are left out (the material model).
+    frequency_hz : float, default 10.0
+        The frequency in Hz.
+    amplitude : float or None, default None
+        Where the marker stands, in display units: mm (axial, radial) or rad (torsion,
+        conical); None: mid-way through the Fletcher–Gent range.
+    n : int, default 60
+        The count of amplitudes on the axis.
+    width : int or None, default 800
+        The width of each plot in pixels; None: as wide as its container.
+
+    Returns
+    -------
+    holoviews.Layout
+        Three plots in one column against amplitude (mm or rad): |K| (kN/mm or N·m/rad), its
+        difference from the single modulus (%), the loss factor (dimensionless).
+    """
     data = curves.slice_comparison(design, frequency_hz, curves.amplitude_grid(design, n))
     at = amplitude if amplitude is not None else float(curves.fletcher_gent_amplitudes(design)[2])
     return sized(hv.Layout(list(slices_overlays(data, dimensions(design.mode), at).values())).cols(1), width)
@@ -235,8 +287,29 @@ def loop_shape_overlay(lp: dict, dims: dict, title: str = "Loop shape during the
 
 def branch_plots(design: Design, frequency_hz: float = 10.0, amplitude: float | None = None, n: int = 80, *,
                  width: int | None = 600) -> hv.Layout:
-    """The Fletcher–Gent effect branch by branch at ``frequency_hz``, and the loop's shape at
-    ``amplitude`` (display units)."""
+    """The Fletcher–Gent effect branch by branch at one frequency, and the loop's shape.
+
+    Parameters
+    ----------
+    design : Design
+        The bushing, in SI units; its stiffness-level effects are left out (the material model).
+    frequency_hz : float, default 10.0
+        The frequency in Hz.
+    amplitude : float or None, default None
+        The loop's amplitude and the marker's place, in display units: mm (axial, radial) or
+        rad (torsion, conical); None: mid-way through the Fletcher–Gent range.
+    n : int, default 80
+        The count of amplitudes on the axis.
+    width : int or None, default 600
+        The width of each plot in pixels; None: as wide as its container.
+
+    Returns
+    -------
+    holoviews.Layout
+        Three plots in one column: Re K (kN/mm or N·m/rad) and the loss factor (dimensionless)
+        against amplitude (mm or rad), stacked branch by branch; the loop scaled to its peak
+        drive and force (dimensionless).
+    """
     at = amplitude if amplitude is not None else float(curves.fletcher_gent_amplitudes(design)[2])
     dims = dimensions(design.mode)
     overlays = branch_overlays(curves.branch_breakdown(design, frequency_hz, curves.amplitude_grid(design, n)), dims, at)
@@ -245,15 +318,47 @@ def branch_plots(design: Design, frequency_hz: float = 10.0, amplitude: float | 
 
 
 def residual_plots(design: Design, measured: MeasuredStiffness, *, width: int | None = 500) -> hv.Layout:
-    """The residuals of ``design`` against measured stiffness."""
+    """The residuals of ``design`` against measured stiffness: model − measured.
+
+    Parameters
+    ----------
+    design : Design
+        The bushing, in SI units; only the measured rows of its mode are drawn.
+    measured : MeasuredStiffness
+        The measured points, SI (docs/files.md): frequency in Hz, amplitude in m or rad,
+        stiffness in N/m or N·m/rad.
+    width : int or None, default 500
+        The width of each plot in pixels; None: as wide as its container.
+
+    Returns
+    -------
+    holoviews.Layout
+        Four plots in two columns: the |K| residual (%) and the loss-factor residual
+        (dimensionless) against frequency (Hz) and amplitude (mm or rad).
+    """
     residuals = curves.measured_residuals(design, measured)
     overlays = residual_overlays(curves.measured_points(measured, design.mode), residuals, dimensions(design.mode))
     return sized(hv.Layout(list(overlays.values())).cols(2), width)
 
 
 def diagnosis_plots(diagnosis, *, width: int | None = 560) -> hv.Layout:
-    """A :class:`core.identify.diagnose.Diagnosis`: the gap after each step, the data against the
-    baseline and the final model, and the misfit maps before and after."""
+    """The plots of a diagnosis: the gap after each step, the curves, the misfit maps.
+
+    Parameters
+    ----------
+    diagnosis : Diagnosis
+        A :class:`core.identify.diagnose.Diagnosis` (SI inside).
+    width : int or None, default 560
+        The width of each plot in pixels; None: as wide as its container.
+
+    Returns
+    -------
+    holoviews.Layout
+        In two columns: the gap after each step (dimensionless); |K| (kN/mm or N·m/rad) and the
+        loss factor (dimensionless) of the data, the baseline and the final model; the misfit
+        maps before and after (|K| in %, the loss factor dimensionless) over frequency (Hz) and
+        amplitude (mm or rad).
+    """
     overlays = diagnosis_overlays(diagnosis)
     return sized(hv.Layout(overlays["gap"] + overlays["curves"] + overlays["maps"]).cols(2), width)
 
@@ -294,8 +399,28 @@ def card_overlays(data: dict, dims: dict, at: dict) -> dict:
 
 def card_plots(design: Design, frequency_hz: float = 10.0, displacement: float = 1e-4, angle: float = 0.01, *,
                width: int | None = 800) -> hv.Layout:
-    """The bushing card's four plots for ``design`` at ``frequency_hz``; the markers at the
-    card's displacement (m) and angle (rad)."""
+    """The bushing card's four plots: every direction of ``design`` at one frequency.
+
+    Parameters
+    ----------
+    design : Design
+        The bushing, in SI units, in any mode: the card takes it into every mode.
+    frequency_hz : float, default 10.0
+        The frequency in Hz.
+    displacement : float, default 1e-4
+        The card's displacement amplitude (the marker), in m (SI, drawn in mm).
+    angle : float, default 0.01
+        The card's angle amplitude (the marker), in rad.
+    width : int or None, default 800
+        The width of each plot in pixels; None: as wide as its container.
+
+    Returns
+    -------
+    holoviews.Layout
+        Four plots in two columns: |K| of the translations (kN/mm) against displacement (mm)
+        and of the rotations (N·m/rad) against angle (rad), and their loss factors
+        (dimensionless).
+    """
     data = curves.card_sweeps(design, frequency_hz)
     at = {"translation": TRANSLATION.amplitude.to_display(displacement),
           "rotation": ROTATION.amplitude.to_display(angle)}

@@ -63,11 +63,38 @@ def _readonly(arr: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True, eq=False)
 class StiffnessResult(ComplexStiffness):
-    """Dynamic stiffness on an amplitude × frequency grid.
+    """Dynamic stiffness on an amplitude × frequency grid, as :func:`stiffness` gives it.
 
     ``stiffness[i, j]`` is the complex K at ``amplitude[i]`` and ``frequency_hz[j]``, in
-    ``units["stiffness"]`` (N/m axially, N·m/rad in torsion). Arrays are read-only (they may
-    come from the cache).
+    ``units["stiffness"]``. Arrays are read-only (they may come from the cache).
+
+    Attributes
+    ----------
+    design : Design
+        The bushing the stiffness is of.
+    frequency_hz : numpy.ndarray
+        The frequencies, shape (F,), in Hz.
+    amplitude : numpy.ndarray
+        The drive amplitudes, shape (A,): peak displacement in m (axial, radial) or peak angle
+        in rad (torsion, conical).
+    stiffness : numpy.ndarray
+        Complex dynamic stiffness K, shape (A, F), in N/m (axial, radial) or N·m/rad (torsion,
+        conical).
+    slices : int or {'continuum'}
+        How the rubber was solved: 1 for the single equivalent modulus (eqs 17, 18), N for N
+        slices in series, ``"continuum"`` for the limit.
+    route : {'analytic', 'time-domain'}
+        How the equivalent modulus was computed.
+    mode : str
+        The design's mode.
+    units : dict of str to str
+        The unit of each quantity: ``frequency_hz`` Hz, ``amplitude`` m or rad, ``stiffness``
+        N/m or N·m/rad, ``force`` N or N·m, and ``drive`` (what the amplitude is: displacement
+        or angle).
+    magnitude : numpy.ndarray
+        |K|, shape (A, F), in N/m or N·m/rad.
+    loss_factor : numpy.ndarray
+        Im K / Re K, shape (A, F), dimensionless.
     """
 
     design: Design
@@ -86,7 +113,15 @@ class StiffnessResult(ComplexStiffness):
         return {"frequency_hz": "Hz", **MODE[self.mode].units}
 
     def table(self) -> dict[str, np.ndarray]:
-        """Flat columns in docs/files.md's order, amplitude by amplitude, each a frequency sweep."""
+        """Flat columns in docs/files.md's order, amplitude by amplitude, each a frequency sweep.
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            A·F values each: ``frequency_hz`` in Hz, ``amplitude`` in m or rad,
+            ``stiffness_real``, ``stiffness_imag`` and ``magnitude`` in N/m or N·m/rad,
+            ``loss_factor`` dimensionless.
+        """
         amp, freq = np.meshgrid(self.amplitude, self.frequency_hz, indexing="ij")
         k = self.stiffness.ravel()
         return {
@@ -213,8 +248,40 @@ def equivalent_stiffness(modulus, s, c, frequency_hz, amplitude):
 
 def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | str = 1,
                      route: Route = "analytic") -> np.ndarray:
-    """Complex stiffness at paired points (frequency_hz[i], amplitude[i]), broadcast together:
-    for measured data, which is no grid. Same model and options as :func:`stiffness`; no cache.
+    """Complex stiffness at paired points (frequency_hz[i], amplitude[i]), broadcast together.
+
+    For measured data, which is no grid: the same model and options as :func:`stiffness`
+    (eqs 14–18 for one slice), without its cache.
+
+    Parameters
+    ----------
+    design : Design
+        The bushing (mode, geometry, material, effects).
+    frequency_hz : float or array_like
+        Frequencies in Hz.
+    amplitude : float or array_like
+        Drive amplitudes, broadcast with ``frequency_hz``: peak displacement in m (axial,
+        radial) or peak angle in rad (torsion, conical).
+    slices : int or {'continuum'}, default 1
+        As for :func:`stiffness`.
+    route : {'analytic', 'time-domain'}, default 'analytic'
+        As for :func:`stiffness`.
+
+    Returns
+    -------
+    numpy.ndarray
+        Complex K, shaped as ``frequency_hz`` and ``amplitude`` broadcast together, in N/m
+        (axial, radial) or N·m/rad (torsion, conical).
+
+    Raises
+    ------
+    ValueError
+        If ``slices`` or ``route`` is none of those allowed, an amplitude is beyond the
+        equivalent strain :data:`MAX_STRAIN`, slices, the continuum or standing waves are asked
+        of a design they are not derived for, or the stiffness is not finite.
+    ConvergenceError
+        If the iteration of the slices, the continuum or the time-domain route does not
+        converge.
     """
     # broadcast, not expanded: on a grid (F,) × (A, 1) the friction term is evaluated per
     # amplitude and the fractional term per frequency, not at every point
@@ -274,17 +341,35 @@ def stiffness(
 
     Parameters
     ----------
-    design : the bushing (mode, geometry, material).
-    frequency_hz : frequencies in Hz (one or more, > 0).
-    amplitude : drive amplitudes, peak angle in rad (torsion) or peak displacement in m (axial).
-    slices : 1 for the single equivalent modulus (eqs 14–18); N > 1 for N concentric slices of
+    design : Design
+        The bushing (mode, geometry, material, effects).
+    frequency_hz : float or array_like
+        Frequencies in Hz, one or more, each positive.
+    amplitude : float or array_like
+        Drive amplitudes, one or more, each positive: peak displacement in m (axial, radial) or
+        peak angle in rad (torsion, conical).
+    slices : int or {'continuum'}, default 1
+        1 for the single equivalent modulus (eqs 14–18); N > 1 for N concentric slices of
         equal radial thickness in series (Paper A); ``"continuum"`` for the limit N → ∞.
         A design with the ``nonuniform_strain`` effect uses the continuum where 1 is asked.
-    route : ``"analytic"`` (closed-form steady state, fast) or ``"time-domain"`` (the thesis'
-        simulation of the strain history, point by point; slow, for checks).
+    route : {'analytic', 'time-domain'}, default 'analytic'
+        ``"analytic"``: the closed-form steady state, fast; ``"time-domain"``: the thesis'
+        simulation of the strain history, point by point (slow, for checks).
 
-    Returns a :class:`StiffnessResult`; repeated queries come from a bounded cache.
-    Raises :class:`core.material.ConvergenceError` if an iteration does not converge.
+    Returns
+    -------
+    StiffnessResult
+        Complex K on the amplitude × frequency grid, in N/m or N·m/rad; repeated queries come
+        from a bounded cache.
+
+    Raises
+    ------
+    ValueError
+        If a frequency or amplitude is not a positive finite number, ``slices`` or ``route`` is
+        none of those allowed, or :func:`stiffness_points` refuses the design or an amplitude.
+    ConvergenceError
+        If the iteration of the slices, the continuum or the time-domain route does not
+        converge.
     """
     f = positive_values("frequency_hz", frequency_hz)
     x = positive_values("amplitude", amplitude)

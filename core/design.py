@@ -57,7 +57,22 @@ def _positive(key: str, value: Any) -> float:
 
 @dataclass(frozen=True)
 class Geometry:
-    """Bonded radii and length of a cylindrical bushing, in metres."""
+    """Bonded radii and length of a cylindrical bushing, in metres.
+
+    Attributes
+    ----------
+    inner_radius : float
+        a, the inner (bonded) radius, in m.
+    outer_radius : float
+        b, the outer (bonded) radius, in m; b > a.
+    length : float
+        L, the bushing's length, in m.
+
+    Raises
+    ------
+    DesignError
+        If a value is no finite number in :data:`SIZE_RANGE` (m) or b ≤ a; it names the key.
+    """
 
     inner_radius: float
     outer_radius: float
@@ -80,7 +95,27 @@ class Geometry:
 
 @dataclass(frozen=True)
 class Material:
-    """The five parameters of the elastic + fractional + friction model (eqs 1–7), SI units."""
+    """The five parameters of the elastic + fractional + friction model (eqs 1–7), SI units.
+
+    Attributes
+    ----------
+    shear_modulus : float
+        µ, the elastic branch's shear modulus (eq 1), in Pa.
+    fractional_coefficient : float
+        m, the fractional-derivative coefficient (eq 3), in Pa·s^α.
+    fractional_order : float
+        α, the fractional order, 0 < α ≤ 1, dimensionless.
+    friction_stress_max : float
+        σ_fmax, the largest friction stress (eq 6), in Pa.
+    friction_strain_half : float
+        ε½, the strain at which half of σ_fmax is built (eq 6), dimensionless.
+
+    Raises
+    ------
+    DesignError
+        If a value is no finite number, a modulus is not in (0, :data:`MAX_MODULUS`] (Pa), α is
+        not in (0, 1] or ε½ not in :data:`STRAIN_HALF_RANGE`; it names the key.
+    """
 
     shear_modulus: float
     fractional_coefficient: float
@@ -122,16 +157,45 @@ def _frozen_effects(effects: Mapping[str, Mapping[str, float]]) -> tuple:
 
 @dataclass(frozen=True)
 class Design:
-    """A bushing: mode (``axial``, ``torsion``, ``radial`` or ``conical``), geometry and
-    material, optionally named; ``shape`` picks the shape factor (``long``: the closed forms,
-    the thesis' for axial and torsion; ``finite``: finite-length FE; ``None``: the mode's
-    default, :data:`DEFAULT_SHAPE`).
+    """A bushing: mode, geometry and material, optionally named, with its model's effects.
 
     ``effects`` holds the model extensions of the discrepancy workflow (docs/model.md's table,
     :mod:`core.effects`); pass a mapping ``{effect_id: {parameter: value}}``: it is validated
     and frozen into a hashable tuple. An effect of the test rig (an apparent mass) acts in the
     design's mode only; one measured on another mode's rig is kept as ``id@mode`` and acts when
     the design is taken into that mode (:meth:`in_mode`).
+
+    Attributes
+    ----------
+    mode : str
+        The direction, one of :data:`core.parameters.MODES` (axial, torsion, radial, conical).
+    geometry : Geometry
+        The bonded radii and length, in m.
+    material : Material
+        The material model's five parameters, SI.
+    name : str or None
+        A name for the design, if any.
+    effects : tuple
+        ((id, ((parameter, value), …)), …), sorted; SI values (a mass in kg, a viscosity in Pa·s).
+    shape : str or None
+        ``long`` (the closed forms), ``finite`` (finite-length FE), None (:data:`DEFAULT_SHAPE`).
+    shape_factor : float
+        S with K = S·µ_eq (eqs 17, 18 if long), in m (translations) or m³/rad (rotations).
+    strain_factor : float
+        c with ε_eq = c·x̂ (eqs 14, 15 if long), in 1/m (translations) or 1/rad (rotations).
+    shape_kind : str
+        The shape factor used: ``shape``, or the mode's default.
+    effect_parameters : dict of str to dict
+        The effects acting in this mode, id → {parameter: value}, SI as ``effects`` (kg, …).
+    portable_effects : dict of str to dict
+        Every effect, this mode's rig effects as ``id@mode``, SI as ``effects`` (kg, …).
+    every_effect : dict of str to dict
+        Every effect, those tied to other modes' rigs too, SI as ``effects`` (kg, …).
+
+    Raises
+    ------
+    DesignError
+        If a field breaks its rule (an unknown mode or shape, a wrong type); it names the key.
     """
 
     mode: str
@@ -166,10 +230,26 @@ class Design:
         object.__setattr__(self, "effects", effects)
 
     def in_mode(self, mode: str) -> Design:
-        """This bushing and material in another direction: the same ``shape`` where the mode
-        allows it (conical has no long form: its default then). Effects of the rubber go with
-        it; an effect of this mode's test rig stays with this mode (as ``id@mode``) and one tied
-        to ``mode`` acts."""
+        """This bushing and material in another direction, with the same ``shape`` if it can.
+
+        Conical has no long form: its default then. Effects of the rubber go with it; an effect
+        of this mode's test rig stays with this mode (as ``id@mode``); one tied to ``mode`` acts.
+
+        Parameters
+        ----------
+        mode : str
+            The new direction, one of :data:`core.parameters.MODES`.
+
+        Returns
+        -------
+        Design
+            The design in ``mode`` (this one if nothing changes).
+
+        Raises
+        ------
+        DesignError
+            If ``mode`` is unknown.
+        """
         shape = None if (mode == "conical" and self.shape == "long") else self.shape
         if (mode, shape) == (self.mode, self.shape):
             return self
@@ -186,13 +266,33 @@ class Design:
         return strain_factor(self.geometry, self.mode, self.shape)
 
     def strain(self, amplitude):
-        """The equivalent strain amplitude ε_eq = c·x̂ of the drive amplitude ``amplitude`` (m or
-        rad; arrays too), eqs 14, 15."""
+        """The equivalent strain amplitude ε_eq = c·x̂ of a drive amplitude (eqs 14, 15).
+
+        Parameters
+        ----------
+        amplitude : float or array_like
+            The drive amplitude x̂: in m (translations) or rad (rotations).
+
+        Returns
+        -------
+        float or numpy.ndarray
+            ε_eq, dimensionless, shaped as ``amplitude``.
+        """
         return self.strain_factor * amplitude
 
     def drive(self, strain):
-        """The drive amplitude x̂ = ε_eq / c (m or rad) that gives the equivalent strain
-        ``strain`` (arrays too): the inverse of :meth:`strain`."""
+        """The drive amplitude x̂ = ε_eq / c of an equivalent strain: :meth:`strain` inverted.
+
+        Parameters
+        ----------
+        strain : float or array_like
+            The equivalent strain amplitude ε_eq, dimensionless.
+
+        Returns
+        -------
+        float or numpy.ndarray
+            x̂, shaped as ``strain``: in m (translations) or rad (rotations).
+        """
         return strain / self.strain_factor
 
     @property
@@ -220,7 +320,24 @@ class Design:
         return {eid: dict(params) for eid, params in self.effects}
 
     def replace(self, **changes) -> Design:
-        """A copy with top-level fields, or geometry/material fields by their own names, changed."""
+        """A copy with top-level fields, or geometry/material fields by their own names, changed.
+
+        Parameters
+        ----------
+        **changes : object
+            New values by field name: the design's, or a geometry field's (in m) or a material
+            field's (in Pa, Pa·s^α or dimensionless) by its own name.
+
+        Returns
+        -------
+        Design
+            The changed copy, validated anew.
+
+        Raises
+        ------
+        DesignError
+            If a changed value breaks its rule (TypeError: a name that is no field).
+        """
         geo = {k: changes.pop(k) for k in list(changes) if k in _GEOMETRY_KEYS}
         mat = {k: changes.pop(k) for k in list(changes) if k in _MATERIAL_KEYS}
         current = {f.name: getattr(self, f.name) for f in fields(self)}
@@ -232,7 +349,14 @@ class Design:
         return Design(**current)
 
     def to_dict(self) -> dict:
-        """The design-file object of docs/files.md."""
+        """The design-file object of docs/files.md.
+
+        Returns
+        -------
+        dict
+            ``name``, ``mode``, ``shape``, ``geometry`` (in m), ``material`` (in Pa, Pa·s^α and
+            dimensionless) and ``effects`` (SI); those unset left out.
+        """
         out: dict[str, Any] = {}
         if self.name is not None:
             out["name"] = self.name

@@ -29,7 +29,31 @@ def force_per_stress(design: Design) -> float:
 class LoopResult:
     """One steady period of the hysteresis loop: drive x(θ) = x̂ sin θ, θ = 2πk/N, k < N.
 
-    Forces in N (axial) or N·m (torsion), displacement in m or rad.
+    Attributes
+    ----------
+    design : Design
+        The bushing the loop is of.
+    frequency_hz : float
+        The drive frequency in Hz.
+    amplitude : float
+        The drive amplitude x̂: peak displacement in m (axial, radial) or peak angle in rad
+        (torsion, conical).
+    phase : numpy.ndarray
+        The drive phases θ = 2πk/N, shape (N,), in rad.
+    displacement : numpy.ndarray
+        The drive x̂ sin θ, shape (N,), in m or rad.
+    force_elastic : numpy.ndarray
+        The elastic branch's force, shape (N,), in N (axial, radial) or moment in N·m (torsion,
+        conical).
+    force_viscoelastic : numpy.ndarray
+        The viscoelastic (fractional, and any viscous) branch's force, in N or N·m.
+    force_friction : numpy.ndarray
+        The friction branch's force, in N or N·m.
+    force : numpy.ndarray
+        The total force, the sum of the three branches, in N or N·m.
+    units : dict of str to str
+        The unit of each quantity: ``amplitude`` m or rad, ``stiffness`` N/m or N·m/rad,
+        ``force`` N or N·m, and ``drive`` (displacement or angle).
     """
 
     design: Design
@@ -50,6 +74,14 @@ class LoopResult:
         return MODE[self.design.mode].units
 
     def table(self) -> dict[str, np.ndarray]:
+        """The loop's columns: the drive, the total force and each branch's.
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            ``displacement`` in m or rad; ``force``, ``force_elastic``, ``force_viscoelastic``
+            and ``force_friction`` in N or N·m; N values each.
+        """
         return {
             "displacement": self.displacement,
             "force": self.force,
@@ -88,7 +120,37 @@ def loop(
     ``route="analytic"`` builds the steady loop in closed form (elastic line, the fractional
     ellipse Im(m(iω)^α ε̂ e^{iθ}), the Berg loop of :func:`steady_friction_loop`);
     ``route="time-domain"`` simulates from rest until the steady state and returns the last
-    period (the same convergence rule as the time-domain modulus).
+    period (the same convergence rule as the time-domain modulus). The force is F = S·σ / (2c)
+    of the material's stresses (:func:`force_per_stress`, eqs 14–18).
+
+    Parameters
+    ----------
+    design : Design
+        The bushing; stiffness-level effects (inertia, non-uniform strain, standing waves) are
+        refused: a loop shows the material's branches.
+    frequency_hz : float
+        The drive frequency in Hz, positive.
+    amplitude : float
+        The drive amplitude x̂, positive: peak displacement in m (axial, radial) or peak angle
+        in rad (torsion, conical).
+    points : int, default 256
+        Samples per period, at least 4.
+    route : {'analytic', 'time-domain'}, default 'analytic'
+        The closed-form steady loop, or the simulated one.
+
+    Returns
+    -------
+    LoopResult
+        The drive in m or rad and the forces in N or N·m (moments), at the phases θ = 2πk/N.
+
+    Raises
+    ------
+    ValueError
+        If the frequency or amplitude is not positive, the amplitude is beyond the equivalent
+        strain :data:`core.bushing.MAX_STRAIN`, ``points`` or ``route`` is not allowed, or the
+        design has a stiffness-level effect.
+    ConvergenceError
+        If the time-domain route does not reach its steady state.
     """
     f = float(positive_values("frequency_hz", frequency_hz)[0])
     xa = float(positive_values("amplitude", amplitude)[0])
@@ -151,7 +213,29 @@ def _time_domain_loop(material, effects, frequency_hz, eps_amp, points):
 
 @dataclass(frozen=True, eq=False)
 class HistoryResult:
-    """Force (moment) history for a sampled displacement (angle) history, branch by branch."""
+    """Force (moment) history for a sampled displacement (angle) history, branch by branch.
+
+    Attributes
+    ----------
+    design : Design
+        The bushing the history is of.
+    time_s : numpy.ndarray
+        The sample times, shape (N,), in s, from 0.
+    displacement : numpy.ndarray
+        The drive, shape (N,): displacement in m (axial, radial) or angle in rad (torsion,
+        conical).
+    force_elastic : numpy.ndarray
+        The elastic branch's force, shape (N,), in N (axial, radial) or moment in N·m (torsion,
+        conical).
+    force_viscoelastic : numpy.ndarray
+        The viscoelastic (fractional, and any viscous) branch's force, in N or N·m.
+    force_friction : numpy.ndarray
+        The friction branch's force, in N or N·m.
+    force_inertia : numpy.ndarray
+        M·d²x/dt² of the ``inertia`` effect (zero without it), in N or N·m.
+    force : numpy.ndarray
+        The total force, the sum of the four parts, in N or N·m.
+    """
 
     design: Design
     time_s: np.ndarray
@@ -167,14 +251,40 @@ class HistoryResult:
 
 
 def force_history(design: Design, displacement, dt: float) -> HistoryResult:
-    """Force (N) or moment (N·m) for any displacement (m) or angle (rad) history sampled every
-    ``dt`` seconds, e.g. from a multibody simulation. O(N log N): the fractional memory is an
-    FFT convolution (eq 3), the friction state changes only at reversals (eq 6).
+    """Force (N) or moment (N·m) for any displacement (m) or angle (rad) history.
 
+    For a history sampled every ``dt`` seconds, e.g. from a multibody simulation. O(N log N):
+    the fractional memory is an FFT convolution (eq 3), the friction state changes only at
+    reversals (eq 6).
+
+    Parameters
+    ----------
+    design : Design
+        The bushing. Material-level effects are simulated (except ``rate_amplitude_coupling``,
+        defined for harmonic drives only); ``inertia`` adds M·d²x/dt² to the total force;
+        ``nonuniform_strain`` and ``wave_effects`` are refused.
+    displacement : array_like
+        The drive history, one-dimensional: displacement in m (axial, radial) or angle in rad
+        (torsion, conical).
+    dt : float
+        The sampling interval in s, positive.
+
+    Returns
+    -------
+    HistoryResult
+        The force (N) or moment (N·m) at each sample, branch by branch.
+
+    Raises
+    ------
+    ValueError
+        If ``displacement`` is not a one-dimensional array of finite numbers, ``dt`` is not a
+        positive finite number, the design has a refused effect, or it has
+        ``rate_amplitude_coupling``.
+
+    Notes
+    -----
     The history starts from rest in the virgin state at zero displacement; a first sample away
-    from zero is reached by a step from zero. Material-level effects are simulated (except
-    ``rate_amplitude_coupling``, defined for harmonic drives only); ``inertia`` adds M·d²x/dt²
-    to the total force; ``nonuniform_strain`` and ``wave_effects`` are refused.
+    from zero is reached by a step from zero.
     """
     x = np.asarray(displacement, dtype=float)
     if x.ndim != 1 or x.size == 0 or not np.all(np.isfinite(x)):

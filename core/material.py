@@ -101,9 +101,26 @@ def fractional_modulus(frequency_hz, fractional_coefficient: float, fractional_o
 def equivalent_modulus(material: Material, frequency_hz, strain_amplitude):
     """µ_eq(ω, ε̂) = µ + m (iω)^α / 2 + µ_f(ε̂) in Pa, broadcast over the two arrays (eq 16).
 
-    ``material`` is a :class:`Material`, or any object with its five fields as arrays that
-    broadcast with the two arguments (e.g. one value per Monte Carlo sample, shaped (n, 1, …),
-    as :mod:`core.whatif.tolerance` gives): the result then has a row per sample."""
+    The analytic steady-state route: the friction modulus µ_f from the closed-form steady loop
+    (:func:`friction_modulus`).
+
+    Parameters
+    ----------
+    material : Material
+        The five parameters (µ in Pa, m in Pa·s^α, α dimensionless, σ_fmax in Pa, ε½
+        dimensionless), or any object with these five fields as arrays that broadcast with the
+        two arguments (e.g. one value per Monte Carlo sample, shaped (n, 1, …), as
+        :mod:`core.whatif.tolerance` gives): the result then has a row per sample.
+    frequency_hz : float or array_like
+        Frequencies in Hz.
+    strain_amplitude : float or array_like
+        Equivalent (tensor) shear strain amplitudes ε̂, dimensionless, positive.
+
+    Returns
+    -------
+    numpy.ndarray
+        Complex µ_eq in Pa, the arguments broadcast together; Im µ_eq ≥ 0 (dissipation).
+    """
     parts = branch_moduli(material, frequency_hz, strain_amplitude)
     return parts["elastic"] + parts["viscoelastic"] + parts["friction"]  # eq 16
 
@@ -250,17 +267,35 @@ def branch_stresses(
 
 
 class ConvergenceError(RuntimeError):
-    """An iteration stopped before meeting its tolerance; no number is returned."""
+    """An iteration stopped before meeting its tolerance; no number is returned.
+
+    Raised by the time-domain route (:func:`equivalent_modulus_time_domain`) and by the slices
+    and the continuum (:func:`core.slices.solve_series`); the message says what did not
+    converge and how far it was.
+    """
 
 
 @dataclass(frozen=True)
 class TimeDomainModulus:
-    """µ_eq from the time-domain route, with how it was reached."""
+    """µ_eq from the time-domain route, with how it was reached.
+
+    Attributes
+    ----------
+    modulus : complex
+        µ_eq in Pa.
+    periods : int
+        The periods simulated.
+    samples_per_period : int
+        The time steps per period.
+    change : float
+        The estimated relative change of µ_eq still to come (:func:`_remaining_change`),
+        dimensionless.
+    """
 
     modulus: complex
     periods: int
     samples_per_period: int
-    change: float  # estimated relative change of µ_eq still to come (see _remaining_change)
+    change: float
 
 
 def _remaining_change(h1: complex, h2: complex, h3: complex) -> float:
@@ -325,6 +360,41 @@ def equivalent_modulus_time_domain(
     |µ_eq|), or :class:`ConvergenceError` is raised. The GL sum is assigned to its second-order time
     t_n − αΔt/2 (a phase shift ωαΔt/2 of its harmonic). Convergence is judged on the last three
     periods (:func:`_remaining_change`).
+
+    Parameters
+    ----------
+    material : Material
+        The five parameters of the model, SI (µ and σ_fmax in Pa, m in Pa·s^α).
+    frequency_hz : float
+        The drive frequency in Hz, positive.
+    strain_amplitude : float
+        The tensor shear strain amplitude ε̂, dimensionless, positive.
+    samples_per_period : int or None, default None
+        Time steps per period; None: enough to resolve the friction knee
+        (:func:`samples_per_period_for`).
+    periods : int, default 8
+        The periods simulated first.
+    max_periods : int, default 1024
+        The most periods simulated before :class:`ConvergenceError`.
+    rtol : float, default 2e-6
+        The relative change of µ_eq still to come that counts as converged, dimensionless.
+    effects : mapping of str to mapping, or None, default None
+        Material-level effects, id → parameters (docs/model.md), in SI units: ``viscous``'s
+        viscosity in Pa·s, ``strain_stiffening``'s β and ``rate_amplitude_coupling``'s γ
+        dimensionless.
+
+    Returns
+    -------
+    TimeDomainModulus
+        ``modulus``, µ_eq in Pa, with the periods and samples it took and the change still to
+        come (dimensionless).
+
+    Raises
+    ------
+    ValueError
+        If the frequency or the strain amplitude is not positive.
+    ConvergenceError
+        If the change still to come is above ``rtol`` after ``max_periods``.
     """
     if not (frequency_hz > 0 and strain_amplitude > 0):
         raise ValueError("frequency and strain amplitude must be positive")

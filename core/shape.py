@@ -244,11 +244,36 @@ def finite_shape_factor(a: float, b: float, L: float, mode: str) -> float:
 
 
 def shape_factor(geometry: Geometry, mode: str, shape: str | None = None) -> float:
-    """S with K = S·µ_eq (m for axial and radial, m³/rad for torsion and conical): the closed
-    forms of :mod:`core.shape` for ``shape="long"`` (torsion S = 4π a² b² L / (b² − a²),
-    eq 17; axial S = 2π L / ln(b/a), eq 18; radial, plane strain), the finite-length FE table
-    for ``"finite"``; ``None``: the mode's default (long for axial and torsion, finite for
-    radial and conical)."""
+    """The shape factor S of a bushing in ``mode``, with K = S·µ_eq.
+
+    The closed forms of :mod:`core.shape` for ``shape="long"`` (torsion S = 4π a² b² L /
+    (b² − a²), eq 17; axial S = 2π L / ln(b/a), eq 18; radial, plane strain), the finite-length
+    FE table for ``"finite"``.
+
+    Parameters
+    ----------
+    geometry : Geometry
+        The bonded radii a, b and the length L, in m.
+    mode : str
+        The direction: one of :data:`core.parameters.MODES`.
+    shape : {'long', 'finite'} or None, default None
+        Which shape factor; ``None``: the mode's default (:data:`core.parameters.DEFAULT_SHAPE`:
+        long for axial and torsion, finite for radial and conical).
+
+    Returns
+    -------
+    float
+        S in m (axial, radial) or m³/rad (torsion, conical).
+
+    Raises
+    ------
+    ValueError
+        If ``"long"`` is asked of the conical mode (no closed form), the geometry lies outside
+        the finite-length table (:class:`OutsideTable`), or ``mode`` is unknown with a ``shape``
+        given.
+    KeyError
+        If ``mode`` is unknown and ``shape`` is None (the default shape is looked up first).
+    """
     a, b, L = geometry.inner_radius, geometry.outer_radius, geometry.length
     if (shape or DEFAULT_SHAPE[mode]) == "finite":
         return finite_shape_factor(a, b, L, mode)
@@ -256,9 +281,30 @@ def shape_factor(geometry: Geometry, mode: str, shape: str | None = None) -> flo
 
 
 def strain_factor(geometry: Geometry, mode: str, shape: str | None = None) -> float:
-    """c with ε_eq = c·x from the energy balance, c = √(S / (4V)), V = π(b² − a²)L: with the
-    long shape factors, torsion c = a b / (b² − a²) (eq 14) and axial
-    c = 1 / sqrt(2 (b² − a²) ln(b/a)) (eq 15). Units 1/rad or 1/m."""
+    """The strain factor c of a bushing in ``mode``, with ε_eq = c·x̂.
+
+    From the energy balance, c = √(S / (4V)), V = π(b² − a²)L: with the long shape factors,
+    torsion c = a b / (b² − a²) (eq 14) and axial c = 1 / sqrt(2 (b² − a²) ln(b/a)) (eq 15).
+
+    Parameters
+    ----------
+    geometry : Geometry
+        The bonded radii a, b and the length L, in m.
+    mode : str
+        The direction: one of :data:`core.parameters.MODES`.
+    shape : {'long', 'finite'} or None, default None
+        Which shape factor, as for :func:`shape_factor`.
+
+    Returns
+    -------
+    float
+        c in 1/m (axial, radial) or 1/rad (torsion, conical).
+
+    Raises
+    ------
+    ValueError
+        As :func:`shape_factor`.
+    """
     a, b, L = geometry.inner_radius, geometry.outer_radius, geometry.length
     if mode == "torsion" and (shape or DEFAULT_SHAPE[mode]) == "long":
         return a * b / (b * b - a * a)  # eq 14, the same number without round-off
