@@ -43,7 +43,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .parameters import DEFAULT_SHAPE, MODES, TRANSLATIONS
+from .parameters import TRANSLATIONS
+from .parameters import mode as checked_mode
 
 if TYPE_CHECKING:  # the type only: core.design imports this module
     from .design import Geometry
@@ -64,6 +65,7 @@ def _radii(a: float, b: float, L: float):
 
 def long_shape_factor(a: float, b: float, L: float, mode: str) -> float:
     """The closed form of ``mode`` (torsion exact; axial and radial for a long bushing)."""
+    checked_mode(mode)
     a, b, L = _radii(a, b, L)
     if mode == "axial":
         return 2.0 * math.pi * L / math.log(b / a)  # eq 18
@@ -72,9 +74,7 @@ def long_shape_factor(a: float, b: float, L: float, mode: str) -> float:
     if mode == "radial":
         s = a * a + b * b
         return 4.0 * math.pi * L * s / (s * math.log(b / a) - (b * b - a * a))
-    if mode == "conical":
-        raise ValueError("conical: no closed form holds for bushings of real length; use shape 'finite'")
-    raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
+    raise ValueError("conical: no closed form holds for bushings of real length; use shape 'finite'")
 
 
 def conical_reference(a: float, b: float, L: float) -> float:
@@ -123,8 +123,9 @@ def _axial_nodes(half_length: float, h: float, wall: float, n: int) -> np.ndarra
 def fe_shape_factor(a: float, b: float, L: float, mode: str, n_r: int = 6) -> tuple[float, int]:
     """S of ``mode`` from the felupe model with ``n_r`` elements across the wall (4 n_r around
     the half circumference, graded along the length); the number of hexahedra of the quarter."""
-    import felupe as fem  # the FE library: only here, for the table and its checks
+    import felupe as fem  # the FE library (the `fe` extra): only here, for the table and its checks
 
+    checked_mode(mode)
     a, b, L = _radii(a, b, L)
     h = (b - a) / n_r
     x_nodes = _axial_nodes(L / 2, h, b - a, n_r)
@@ -144,11 +145,9 @@ def fe_shape_factor(a: float, b: float, L: float, mode: str, n_r: int = 6) -> tu
     elif mode == "torsion":  # about the axis x
         angle = step / b
         u = np.column_stack([zero, -angle * p[:, 2], angle * p[:, 1]])
-    elif mode == "conical":  # about the diameter z, through the centre
+    else:  # conical: about the diameter z, through the centre
         angle = step / L
         u = np.column_stack([-angle * p[:, 1], angle * p[:, 0], zero])
-    else:
-        raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     held_mid, held_plane = _HELD[mode]
     free = ~inner & ~outer
     boundaries = {
@@ -235,11 +234,10 @@ def table() -> ShapeTable:
 def finite_shape_factor(a: float, b: float, L: float, mode: str) -> float:
     """S of a bushing of real length: the table's converged FE ratio times the reference
     (torsion: its exact formula, which the FE reproduces)."""
+    checked_mode(mode)
     a, b, L = _radii(a, b, L)
     if mode == "torsion":
         return long_shape_factor(a, b, L, "torsion")
-    if mode not in MODES:
-        raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     return reference_shape_factor(a, b, L, mode) * table().ratio(mode, b / a, L / (b - a))
 
 
@@ -269,13 +267,10 @@ def shape_factor(geometry: Geometry, mode: str, shape: str | None = None) -> flo
     ------
     ValueError
         If ``"long"`` is asked of the conical mode (no closed form), the geometry lies outside
-        the finite-length table (:class:`OutsideTable`), or ``mode`` is unknown with a ``shape``
-        given.
-    KeyError
-        If ``mode`` is unknown and ``shape`` is None (the default shape is looked up first).
+        the finite-length table (:class:`OutsideTable`), or ``mode`` is unknown.
     """
     a, b, L = geometry.inner_radius, geometry.outer_radius, geometry.length
-    if (shape or DEFAULT_SHAPE[mode]) == "finite":
+    if (shape or checked_mode(mode).default_shape) == "finite":
         return finite_shape_factor(a, b, L, mode)
     return long_shape_factor(a, b, L, mode)
 
@@ -306,8 +301,9 @@ def strain_factor(geometry: Geometry, mode: str, shape: str | None = None) -> fl
         As :func:`shape_factor`.
     """
     a, b, L = geometry.inner_radius, geometry.outer_radius, geometry.length
-    if mode == "torsion" and (shape or DEFAULT_SHAPE[mode]) == "long":
+    kind = shape or checked_mode(mode).default_shape
+    if mode == "torsion" and kind == "long":
         return a * b / (b * b - a * a)  # eq 14, the same number without round-off
-    if mode == "axial" and (shape or DEFAULT_SHAPE[mode]) == "long":
+    if mode == "axial" and kind == "long":
         return 1.0 / np.sqrt(2.0 * (b * b - a * a) * np.log(b / a))  # eq 15
     return strain_factor_from_shape(shape_factor(geometry, mode, shape), a, b, L)

@@ -206,3 +206,13 @@ def test_a_radial_measurement_identifies_the_material():
     expected = parameter_values(PAPER_B)
     for name, (lo, hi) in result.intervals.items():
         assert lo <= expected[name] <= hi, name
+
+
+@pytest.mark.parametrize("shape", [None, "long", "finite"])
+def test_an_unknown_mode_is_refused_by_name_with_or_without_a_shape(shape):
+    # with no shape the mode's default shape was looked up first: a KeyError, not the rule
+    from core.shape import shape_factor, strain_factor
+
+    for factor in (shape_factor, strain_factor):
+        with pytest.raises(ValueError, match="mode must be one of axial, torsion, radial, conical, got 'sideways'"):
+            factor(PAPER_B.geometry, "sideways", shape)
