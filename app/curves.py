@@ -22,9 +22,10 @@ from core.bushing import (
     stiffness_points,
     strain_factor,
 )
-from core.data import MeasuredLoop, MeasuredStiffness, loss_factor, magnitude_residual_pct
+from core.data import MeasuredLoop, MeasuredStiffness
 from core.identify.fit import folded, gap
 from core.material import ConvergenceError
+from core.response import loss_factor, magnitude_residual_pct
 
 from . import units
 

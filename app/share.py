@@ -8,9 +8,9 @@ import io
 import numpy as np
 import panel as pn
 
-from core.data import csv_text
-from core.design import dumps_design
+from core.io.design_file import dumps_design
 from core.io.export import export
+from core.io.table import csv_text
 
 from .state import ExplorerState
 from .units import to_si_amplitude

@@ -16,17 +16,11 @@ import param
 
 from core import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material
 from core.bushing import factors, stiffness, strain_factor
-from core.data import (
-    DataError,
-    MeasuredLoop,
-    MeasuredStiffness,
-    combined,
-    parse_loop,
-    parse_stiffness,
-)
+from core.data import DataError, MeasuredLoop, MeasuredStiffness
 from core.design import SIZE_RANGE, as_dict
 from core.identify.fit import PARAMETERS as MATERIAL_PARAMETERS
 from core.identify.fit import FitResult, fit_global, fit_two_step, predicted, selection
+from core.io.measured import combined, parse_loop, parse_stiffness
 from core.whatif.tolerance import (
     SAMPLES,
     FitCovariance,

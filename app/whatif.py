@@ -12,8 +12,9 @@ import holoviews as hv
 import panel as pn
 import param
 
+from core.io.targets import problem_from_dict
 from core.whatif.sensitivity import SENSITIVITY_PARAMETERS, SYMBOLS, elasticities, ranked, sentence
-from core.whatif.target import Found, TargetError, problem_from_dict, solve
+from core.whatif.target import Found, TargetError, solve
 from core.whatif.tolerance import ToleranceError
 
 from . import plots, units

@@ -15,18 +15,8 @@ from .bushing import (
     stiffness_points,
     strain_factor,
 )
-from .design import (
-    PAPER_B,
-    TABLE_1,
-    Design,
-    DesignError,
-    Geometry,
-    Material,
-    dumps_design,
-    loads_design,
-    read_design,
-    write_design,
-)
+from .design import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material
+from .io.design_file import dumps_design, loads_design, read_design, write_design
 from .material import ConvergenceError, equivalent_modulus, equivalent_modulus_time_domain
 
 __all__ = [

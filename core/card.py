@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from .bushing import factors, stiffness_points
-from .data import loss_factor
 from .design import TRANSLATIONS, Design
+from .response import loss_factor
 
 CARD_MODES = ("axial", "radial", "torsion", "conical")
 

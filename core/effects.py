@@ -18,13 +18,18 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from scipy import special
 
-from .design import MODES, ROTATIONS, DesignError, Material, _number
 from .material import REFERENCE_FREQUENCY_HZ, fractional_modulus, friction_modulus
+from .parameters import MODES, ROTATIONS
+from .rules import DesignError
+from .rules import number as _number
+
+if TYPE_CHECKING:
+    from .design import Material
 
 
 @dataclass(frozen=True)

@@ -12,12 +12,14 @@ from hypothesis import strategies as st
 from cli.main import main
 from core import PAPER_B, TABLE_1, write_design
 from core.bushing import stiffness_points
-from core.data import loss_factor
 from core.identify.fit import PARAMETERS, fit_global, parameter
+from core.io.targets import problem_from_dict
+from core.io.tolerances import loads_tolerances
+from core.response import loss_factor
 from core.synthetic import synthetic_stiffness
 from core.whatif.sensitivity import elasticities, log_derivatives, sentence, value_of
-from core.whatif.target import TargetError, problem_from_dict, solve
-from core.whatif.tolerance import FitCovariance, ToleranceError, Tolerances, band, loads_tolerances
+from core.whatif.target import TargetError, solve
+from core.whatif.tolerance import FitCovariance, ToleranceError, Tolerances, band
 
 F = np.linspace(1, 100, 40)
 
@@ -345,7 +347,7 @@ def test_the_vectorised_band_is_the_sample_by_sample_one(mode):
     ('[' * 40000 + ']' * 40000, "nested too deeply"),
 ])
 def test_a_targets_file_is_strict_json(text, match):
-    from core.whatif.target import loads_problem
+    from core.io.targets import loads_problem
 
     with pytest.raises(TargetError, match=match):
         loads_problem(text)

@@ -25,8 +25,8 @@ import numpy as np
 
 from ..bushing import UNITS, stiffness_points, strain_factor
 from ..card import CARD_MODES, card_design
-from ..data import csv_text
 from ..design import Design
+from .table import csv_text
 
 MAX_EXPORT_POINTS = 100_000  # frequencies × amplitudes of one export
 

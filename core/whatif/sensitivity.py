@@ -17,9 +17,9 @@ import math
 import numpy as np
 
 from ..bushing import stiffness_points
-from ..data import loss_factor
 from ..design import Design
 from ..identify.fit import PARAMETERS as MATERIAL_PARAMETERS
+from ..response import loss_factor
 
 GEOMETRY_PARAMETERS = ("inner_radius", "outer_radius", "length")
 SENSITIVITY_PARAMETERS = GEOMETRY_PARAMETERS + MATERIAL_PARAMETERS
