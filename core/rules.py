@@ -139,6 +139,14 @@ def is_number(value: Any) -> bool:
     return True
 
 
+def whole_number(value: Any, low: int, high: int) -> str | None:
+    """None if ``value`` is a whole number (an int, not a bool) from ``low`` to ``high``; else
+    the code of the rule it breaks: ``not_a_number`` or ``out_of_range``."""
+    if isinstance(value, bool) or not isinstance(value, int):
+        return NOT_A_NUMBER
+    return None if low <= value <= high else OUT_OF_RANGE
+
+
 def decimal(text: str, key: str = "", error: type[RuleError] = RuleError) -> float:
     """The number a text (a CSV cell, a command-line number) writes, surrounding blanks aside,
     as a finite float; else ``error`` with the code: ``missing_key`` (blank), ``not_finite``

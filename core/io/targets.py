@@ -22,7 +22,6 @@ from ..rules import (
     BAD_TYPE,
     CONFLICT,
     MISSING_KEY,
-    NOT_A_NUMBER,
     NOT_POSITIVE,
     OUT_OF_RANGE,
     UNKNOWN_KEY,
@@ -31,6 +30,7 @@ from ..rules import (
     positive,
     read_text,
     strict_json,
+    whole_number,
 )
 from ..whatif.target import Problem, Target, TargetError
 from .design_file import design_from_dict
@@ -176,9 +176,8 @@ def problem_from_dict(data: Any) -> Problem:
             raise TargetError(f"free_material.{name}", "an empty range", OUT_OF_RANGE)
         free[name] = (low, high)
     n = data.get("solutions", 3)
-    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_SOLUTIONS:
-        raise TargetError("solutions", f"a whole number from 1 to {MAX_SOLUTIONS}",
-                          NOT_A_NUMBER if isinstance(n, bool) or not isinstance(n, int) else OUT_OF_RANGE)
+    if code := whole_number(n, 1, MAX_SOLUTIONS):
+        raise TargetError("solutions", f"a whole number from 1 to {MAX_SOLUTIONS}", code)
     # the fixed variables must lie within their limits
     values = Problem(start, parsed, limits, free, tuple(fixed)).values(start)
     for name in fixed:

@@ -45,6 +45,7 @@ from ..rules import (
     UNKNOWN_KEY,
     RuleError,
     is_number,
+    whole_number,
 )
 from .sensitivity import GEOMETRY_PARAMETERS, SENSITIVITY_PARAMETERS, log_derivatives, value_of
 
@@ -105,16 +106,6 @@ class FitCovariance:
         return names, corr * np.outer(sd, sd)
 
 
-def _whole(value, low: int, high: int) -> bool:
-    """Whether ``value`` is an int (not a bool) from ``low`` to ``high``."""
-    return not isinstance(value, bool) and isinstance(value, int) and low <= value <= high
-
-
-def _whole_code(value) -> str:
-    """The code of a count :func:`_whole` refuses: out of its range, or no whole number."""
-    return OUT_OF_RANGE if not isinstance(value, bool) and isinstance(value, int) else NOT_A_NUMBER
-
-
 @dataclass(frozen=True)
 class Tolerances:
     """Tolerances of a design's parameters: ``relative`` (a fraction of the value) or
@@ -149,12 +140,11 @@ class Tolerances:
         if self.distribution not in DISTRIBUTIONS:
             raise ToleranceError("distribution", f"must be one of {', '.join(DISTRIBUTIONS)}, got "
                                  f"{str(self.distribution)[:40]}", BAD_CHOICE)
-        if not _whole(self.samples, SAMPLE_RANGE[0], SAMPLE_RANGE[1]):
+        if code := whole_number(self.samples, *SAMPLE_RANGE):
             raise ToleranceError("samples", f"a whole number from {SAMPLE_RANGE[0]} to {SAMPLE_RANGE[1]}, got "
-                                 f"{str(self.samples)[:40]}", _whole_code(self.samples))
-        if not _whole(self.seed, 0, 2**63 - 1):
-            raise ToleranceError("seed", f"a whole number from 0 to 2^63 − 1, got {str(self.seed)[:40]}",
-                                 _whole_code(self.seed))
+                                 f"{str(self.samples)[:40]}", code)
+        if code := whole_number(self.seed, 0, 2**63 - 1):
+            raise ToleranceError("seed", f"a whole number from 0 to 2^63 − 1, got {str(self.seed)[:40]}", code)
         if not self.percentiles or any(not is_number(q) or not 0 <= q <= 100 for q in self.percentiles) or \
                 len(self.percentiles) > 9:
             raise ToleranceError("percentiles", f"one to nine numbers from 0 to 100, got "
