@@ -1,5 +1,6 @@
 """Measured data (docs/files.md): dynamic-stiffness tables and hysteresis loops, as the fits
-and the diagnosis take them. Their files are read and written by :mod:`core.io.measured`.
+and the diagnosis take them. Their files are read by :mod:`core.io.measured`; ``to_csv`` writes
+them (the CSV of :mod:`core.io.table`).
 
 All numbers are SI: Hz, m or rad, N/m or N·m/rad, s, N or N·m.
 """
