@@ -21,11 +21,12 @@ from core.bushing import (
     stiffness_points,
 )
 from core.card import CARD_MODES, card_design
-from core.data import MeasuredLoop, MeasuredStiffness, loss_factor, magnitude_residual_pct
+from core.data import MeasuredLoop, MeasuredStiffness
 from core.identify.fit import folded, model_stiffness, selection
 from core.loops import loop
 from core.material import ConvergenceError
 from core.residuals import gap
+from core.response import loss_factor, magnitude_residual_pct
 from core.whatif.tolerance import band
 
 from . import units

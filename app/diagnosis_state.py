@@ -6,9 +6,11 @@ from __future__ import annotations
 import numpy as np
 import param
 
-from core.data import MeasuredStiffness, csv_text, parse_stiffness
+from core.data import MeasuredStiffness
 from core.effects import EFFECTS
 from core.identify.diagnose import BRANCHES, Diagnosis, diagnose
+from core.io.measured import parse_stiffness
+from core.io.table import csv_text
 from core.synthetic import MYSTERIES, Mystery
 
 from . import curves

@@ -10,9 +10,9 @@ import numpy as np
 import panel as pn
 import param
 
-from core.data import csv_text
-from core.design import dumps_design
+from core.io.design_file import dumps_design
 from core.io.export import export
+from core.io.table import csv_text
 from core.parameters import PARAMETERS
 
 from .state import ExplorerState

@@ -16,15 +16,9 @@ import param
 
 from core import PAPER_B, TABLE_1, Design
 from core.bushing import stiffness
-from core.data import (
-    DataError,
-    MeasuredLoop,
-    MeasuredStiffness,
-    combined,
-    parse_loop,
-    parse_stiffness,
-)
+from core.data import DataError, MeasuredLoop, MeasuredStiffness
 from core.identify.fit import FitResult, fit_global, fit_two_step, predicted, selection
+from core.io.measured import combined, parse_loop, parse_stiffness
 from core.parameters import MODE_TABLE, MODES
 from core.whatif.tolerance import band, band_columns
 

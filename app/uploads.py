@@ -12,7 +12,7 @@ from collections.abc import Callable
 
 import panel as pn
 
-from core.data import MAX_BYTES
+from core.io.measured import MAX_BYTES
 
 CHUNK_BYTES = 4 * 1024 * 1024  # per websocket message (app.main.UPLOAD_MESSAGE_BYTES allows 16 MB)
 LIMIT = f"{MAX_BYTES // (1024 * 1024)}MB"

@@ -12,9 +12,10 @@ import holoviews as hv
 import panel as pn
 import param
 
+from core.io.targets import problem_from_dict
 from core.parameters import BY_NAME, GEOMETRY, NAMES, TRANSLATIONS
 from core.whatif.sensitivity import elasticities, ranked, sentence
-from core.whatif.target import Found, TargetError, problem_from_dict, solve
+from core.whatif.target import Found, TargetError, solve
 from core.whatif.tolerance import ToleranceError
 
 from . import plots, units

@@ -13,8 +13,9 @@ import time
 import numpy as np
 
 from core import PAPER_B, TABLE_1
-from core.data import MeasuredStiffness, combined
+from core.data import MeasuredStiffness
 from core.identify.diagnose import diagnose
+from core.io.measured import combined
 from core.synthetic import synthetic_stiffness
 
 TARGET_S = 5.0

@@ -12,8 +12,9 @@ import time
 import numpy as np
 
 from core import PAPER_B, TABLE_1
-from core.data import MeasuredStiffness, combined
+from core.data import MeasuredStiffness
 from core.identify.fit import fit_global, fit_two_step
+from core.io.measured import combined
 from core.synthetic import synthetic_loop, synthetic_stiffness
 
 

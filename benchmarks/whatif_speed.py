@@ -15,8 +15,9 @@ import numpy as np
 from app import curves
 from core import PAPER_B
 from core.bushing import stiffness_points
+from core.io.targets import problem_from_dict
 from core.whatif.sensitivity import elasticities
-from core.whatif.target import problem_from_dict, solve
+from core.whatif.target import solve
 from core.whatif.tolerance import Tolerances, _sample_factors, band
 
 TOL = Tolerances({"shear_modulus": 0.10, "friction_stress_max": 0.15, "fractional_order": 0.05},

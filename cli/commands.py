@@ -14,16 +14,18 @@ import sys
 import time
 import warnings
 from contextlib import contextmanager
-from pathlib import Path
 
 import numpy as np
 
 from core.bushing import MAX_SLICES, slice_count, stiffness
-from core.data import MAX_ROWS, DataError, csv_text
-from core.design import DesignError, read_design, read_design_file
+from core.data import DataError
+from core.io.design_file import read_design, read_design_file
+from core.io.measured import MAX_ROWS, combined, read_loop, read_stiffness
+from core.io.table import csv_text
 from core.loops import loop
 from core.material import ConvergenceError
 from core.parameters import BRANCH_PARAMETERS, MODE, ROTATIONS, TRANSLATIONS
+from core.rules import DECIMAL, OVERFLOW, DesignError, RuleError, decimal
 
 NUMBER_FORMAT = "{:.12g}"
 # the largest sizes the command line computes (docs/files.md): a grid of at most a million
@@ -34,7 +36,6 @@ MAX_GRID = 1_000_000
 # form does millions a second, the thesis' time-domain simulation about thirty
 MAX_SLICE_POINTS = {"analytic": 20_000_000, "time-domain": 600}
 MAX_LOOP_POINTS = 1_000_000
-NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
 CARD_DISPLACEMENT = MODE[TRANSLATIONS[0]].amplitude  # the card's displacements: in mm, as people read them
 
 
@@ -49,9 +50,12 @@ class _Parser(argparse.ArgumentParser):
 
 def _positive(name):
     def parse(text: str) -> float:
-        if not NUMBER.fullmatch(str(text).strip()):  # Python's float() also takes "1_000", "nan", "inf"
-            raise argparse.ArgumentTypeError(f"{name} must be a number, got {text!r}")
-        value = float(text)
+        try:  # the data files' rule: Python's float() also takes "1_000", "nan", "inf"
+            value = decimal(text)
+        except RuleError as exc:
+            if exc.code != OVERFLOW:
+                raise argparse.ArgumentTypeError(f"{name} must be a number, got {text!r}") from None
+            value = math.inf
         if not math.isfinite(value) or value <= 0:
             raise argparse.ArgumentTypeError(f"{name} must be a positive finite number, got {text!r}")
         return value
@@ -306,27 +310,16 @@ def _cmd_stiffness(args) -> None:
 def _read_tolerances(path: str, fit_report: dict | None):
     """The tolerance file, with the design file's fit report for when it asks for the fit's
     covariance."""
-    from core.whatif.tolerance import MAX_FILE_BYTES, loads_tolerances
+    from core.io.tolerances import read_tolerances
 
-    return loads_tolerances(_small_text(path, "tolerance", MAX_FILE_BYTES), fit_report)
-
-
-def _small_text(path: str, what: str, limit: int) -> str:
-    """A JSON input file's text, refused beyond ``limit`` bytes, unreadable or not UTF-8."""
-    try:
-        if Path(path).stat().st_size > limit:
-            raise InputError(f"bushing: the {what} file {path!r} is larger than {limit} bytes")
-        return Path(path).read_text(encoding="utf-8-sig")
-    except OSError as exc:
-        raise InputError(f"bushing: cannot read the {what} file {path!r}: {exc.strerror}") from None
-    except UnicodeDecodeError:
-        raise InputError(f"bushing: the {what} file {path!r} is not UTF-8 text") from None
+    return read_tolerances(path, fit_report)
 
 
 def _cmd_design(args) -> None:
-    from core.whatif.target import MAX_FILE_BYTES, loads_problem, solve
+    from core.io.targets import read_problem
+    from core.whatif.target import solve
 
-    found = solve(loads_problem(_small_text(args.targets, "targets", MAX_FILE_BYTES)))
+    found = solve(read_problem(args.targets))
     _write_text(found.to_json(), args.output)
     if args.output:
         sys.stdout.write(found.statement + "\n")
@@ -368,8 +361,6 @@ MAX_MEASURED_FILES = 20
 
 def _read_measured(paths: list[str], design):
     """The measured files as one table (rows without a mode in the design's mode)."""
-    from core.data import combined, read_stiffness
-
     if len(paths) > MAX_MEASURED_FILES:
         raise InputError(f"bushing: at most {MAX_MEASURED_FILES} measured files, got {len(paths)}")
     parts, rows = [], 0
@@ -382,7 +373,6 @@ def _read_measured(paths: list[str], design):
 
 
 def _cmd_fit(args) -> None:
-    from core.data import read_loop
     from core.identify.fit import fit_global, predicted, selection
 
     design = read_design(args.design)
@@ -479,7 +469,7 @@ def main(argv: list[str] | None = None, parser: argparse.ArgumentParser | None =
         warnings.simplefilter("ignore")  # numerical warnings never reach users: results are checked
         option = ""
         for token in argv:
-            if token.startswith("-") and NUMBER.fullmatch(token):
+            if token.startswith("-") and DECIMAL.fullmatch(token):
                 raise InputError(f"bushing: {option} {token}: every number on the command line is positive "
                                  "(amplitudes, frequencies, counts)")
             if token.startswith("-"):

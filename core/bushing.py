@@ -23,10 +23,10 @@ from typing import Literal
 import numpy as np
 
 from . import material as mat
-from .data import ComplexStiffness, loss_factor
 from .design import Design
 from .effects import EFFECTS, branch_moduli, extended_modulus, inertia_correction, wave_stiffness
 from .parameters import MODE, THESIS_MODES
+from .response import ComplexStiffness, loss_factor
 from .shape import shape_factor, strain_factor  # noqa: F401 (re-exported)
 from .slices import continuum_node_count, continuum_nodes, slice_nodes, solve_series
 

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 from .bushing import factors, stiffness_points
-from .data import loss_factor
 from .design import Design
 from .parameters import ROTATIONS, THESIS_MODES, TRANSLATIONS
+from .response import loss_factor
 
 CARD_MODES = TRANSLATIONS + ROTATIONS  # axial, radial, torsion, conical
 

@@ -1,58 +1,39 @@
-"""Bushing designs: validated, immutable geometry, material and mode, and the design file.
+"""Bushing designs: validated, immutable geometry, material and mode (the design file is
+:mod:`core.io.design_file`).
 
 The parameters' symbols, names and units are those of the one table, :mod:`core.parameters`
 (docs/model.md, "Symbols and units"): geometry in m, moduli and stresses in Pa.
 
 A value that breaks a rule is refused at the door with a :class:`DesignError` whose message
-names the key (``geometry.outer_radius``) and the rule.
+names the key (``geometry.outer_radius``) and the rule, and whose ``code`` says which rule
+(:mod:`core.rules`).
 """
 
 from __future__ import annotations
 
-import json
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
-from pathlib import Path
 from typing import Any
 
+from .effects import EFFECTS, validate_effects
 from .parameters import DEFAULT_SHAPE, MODES, SHAPES
+from .rules import (
+    BAD_CHOICE,
+    BAD_TYPE,
+    DUPLICATE_KEY,
+    ORDER_RANGE,
+    OUT_OF_RANGE,
+    OUTER_NOT_LARGER,
+    DesignError,
+    number,
+    positive,
+)
 from .shape import shape_factor, strain_factor
 
 # shape factors: closed forms of long bushings (the thesis'), or finite-length FE (core/shape.py)
 SIZE_RANGE = (1e-6, 1e3)  # m: radii and lengths from a micrometre to a kilometre, no further
 MAX_MODULUS = 1e12  # Pa: µ, m and σ_fmax at most 1 TPa (diamond's shear modulus is about half that)
 STRAIN_HALF_RANGE = (1e-9, 10.0)  # ε½: the range the fit searches
-MAX_DESIGN_BYTES = 1_000_000  # a design file is a few hundred bytes; one of a megabyte is not one
-
-
-class DesignError(ValueError):
-    """A design value or file breaks a rule; ``key`` names the offending field."""
-
-    def __init__(self, key: str, rule: str):
-        self.key = key
-        self.rule = rule
-        super().__init__(f"{key}: {rule}" if key else rule)
-
-
-def _number(key: str, value: Any) -> float:
-    """Return ``value`` as a finite float or refuse it, naming ``key``."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise DesignError(key, f"must be a number, got {value!r}")
-    try:
-        value = float(value)
-    except OverflowError:  # an integer too large for a float
-        raise DesignError(key, "must be a finite number, got an integer too large for a float") from None
-    if not math.isfinite(value):
-        raise DesignError(key, f"must be a finite number, got {value!r}")
-    return value
-
-
-def _positive(key: str, value: Any) -> float:
-    value = _number(key, value)
-    if value <= 0.0:
-        raise DesignError(key, f"must be positive, got {value!r}")
-    return value
 
 
 @dataclass(frozen=True)
@@ -81,15 +62,17 @@ class Geometry:
     def __post_init__(self):
         for f in fields(self):
             key = f"geometry.{f.name}"
-            value = _positive(key, getattr(self, f.name))
+            value = positive(key, getattr(self, f.name))
             if not SIZE_RANGE[0] <= value <= SIZE_RANGE[1]:
-                raise DesignError(key, f"must lie between {SIZE_RANGE[0]:g} and {SIZE_RANGE[1]:g} m, got {value!r}")
+                raise DesignError(key, f"must lie between {SIZE_RANGE[0]:g} and {SIZE_RANGE[1]:g} m, got {value!r}",
+                                  OUT_OF_RANGE)
             object.__setattr__(self, f.name, value)
         if self.outer_radius <= self.inner_radius:
             raise DesignError(
                 "geometry.outer_radius",
                 f"must be larger than geometry.inner_radius (b > a), got b = {self.outer_radius!r}"
                 f" and a = {self.inner_radius!r}",
+                OUTER_NOT_LARGER,
             )
 
 
@@ -128,18 +111,18 @@ class Material:
             key = f"material.{f.name}"
             value = getattr(self, f.name)
             if f.name == "fractional_order":
-                value = _number(key, value)
+                value = number(key, value)
                 if not 0.0 < value <= 1.0:
-                    raise DesignError(key, f"must lie in (0, 1], got {value!r}")
+                    raise DesignError(key, f"must lie in (0, 1], got {value!r}", ORDER_RANGE)
             elif f.name == "friction_strain_half":
-                value = _positive(key, value)
+                value = positive(key, value)
                 if not STRAIN_HALF_RANGE[0] <= value <= STRAIN_HALF_RANGE[1]:
                     raise DesignError(key, f"must lie between {STRAIN_HALF_RANGE[0]:g} and {STRAIN_HALF_RANGE[1]:g}, "
-                                      f"got {value!r}")
+                                      f"got {value!r}", OUT_OF_RANGE)
             else:
-                value = _positive(key, value)
+                value = positive(key, value)
                 if value > MAX_MODULUS:
-                    raise DesignError(key, f"must be at most {MAX_MODULUS:g} Pa, got {value!r}")
+                    raise DesignError(key, f"must be at most {MAX_MODULUS:g} Pa, got {value!r}", OUT_OF_RANGE)
             object.__setattr__(self, f.name, value)
 
 
@@ -149,8 +132,6 @@ def _frozen_effects(effects: Mapping[str, Mapping[str, float]]) -> tuple:
         effects = {eid: dict(params) for eid, params in effects}
     if isinstance(effects, Mapping) and not effects:
         return ()
-    from .effects import validate_effects  # the effect library knows its own parameters
-
     checked = validate_effects(effects)
     return tuple(sorted((eid, tuple(sorted(p.items()))) for eid, p in checked.items()))
 
@@ -207,17 +188,18 @@ class Design:
 
     def __post_init__(self):
         if self.mode not in MODES:
-            raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {self.mode!r}")
+            raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {self.mode!r}", BAD_CHOICE)
         if self.shape is not None and self.shape not in SHAPES:
-            raise DesignError("shape", f"must be one of {', '.join(SHAPES)}, got {self.shape!r}")
+            raise DesignError("shape", f"must be one of {', '.join(SHAPES)}, got {self.shape!r}", BAD_CHOICE)
         if self.mode == "conical" and self.shape == "long":
-            raise DesignError("shape", "conical: no closed form holds for bushings of real length; use 'finite'")
+            raise DesignError("shape", "conical: no closed form holds for bushings of real length; use 'finite'",
+                              BAD_CHOICE)
         if not isinstance(self.geometry, Geometry):
-            raise DesignError("geometry", "must be a Geometry")
+            raise DesignError("geometry", "must be a Geometry", BAD_TYPE)
         if not isinstance(self.material, Material):
-            raise DesignError("material", "must be a Material")
+            raise DesignError("material", "must be a Material", BAD_TYPE)
         if self.name is not None and not isinstance(self.name, str):
-            raise DesignError("name", f"must be a string, got {self.name!r}")
+            raise DesignError("name", f"must be a string, got {self.name!r}", BAD_TYPE)
         effects = _frozen_effects(self.effects)
         own = f"@{self.mode}"
         if any(eid.endswith(own) for eid, _ in effects):  # tied to this design's own mode: plain
@@ -225,7 +207,7 @@ class Design:
             twice = sorted({i for i in ids if ids.count(i) > 1})
             if twice:
                 raise DesignError(f"effects.{twice[0]}{own}", f"{twice[0]} is given for the {self.mode} "
-                                                             f"mode twice (with and without {own})")
+                                                             f"mode twice (with and without {own})", DUPLICATE_KEY)
             effects = tuple(sorted((eid.removesuffix(own), p) for eid, p in effects))
         object.__setattr__(self, "effects", effects)
 
@@ -309,8 +291,6 @@ class Design:
     def portable_effects(self) -> dict[str, dict[str, float]]:
         """Every effect, this mode's rig effects tied to it (``id@mode``): what a design of any
         mode built from them carries (the tie to its own mode falls away)."""
-        from .effects import EFFECTS
-
         return {(f"{eid}@{self.mode}" if "@" not in eid and EFFECTS[eid].rig else eid): dict(p)
                 for eid, p in self.effects}
 
@@ -372,123 +352,10 @@ class Design:
 
 _GEOMETRY_KEYS = tuple(f.name for f in fields(Geometry))
 _MATERIAL_KEYS = tuple(f.name for f in fields(Material))
-_TOP_KEYS = ("name", "mode", "shape", "geometry", "material", "effects", "fit")
 
 
 def as_dict(value) -> dict[str, float]:
     return {f.name: getattr(value, f.name) for f in fields(value)}
-
-
-def _exact_keys(where: str, obj: Any, allowed: tuple[str, ...], required: tuple[str, ...]):
-    if not isinstance(obj, Mapping):
-        raise DesignError(where, f"must be an object with keys {', '.join(allowed)}")
-    prefix = f"{where}." if where else ""
-    for key in obj:
-        if key not in allowed:
-            raise DesignError(
-                f"{prefix}{key}", f"unknown key (allowed: {', '.join(allowed)})"
-            )
-    for key in required:
-        if key not in obj:
-            raise DesignError(f"{prefix}{key}", "missing (required)")
-
-
-def design_from_dict(data: Any) -> Design:
-    """Build a :class:`Design` from a design-file object (docs/files.md), refusing anything off."""
-    _exact_keys("", data, _TOP_KEYS, ("mode", "geometry", "material"))
-    _exact_keys("geometry", data["geometry"], _GEOMETRY_KEYS, _GEOMETRY_KEYS)
-    _exact_keys("material", data["material"], _MATERIAL_KEYS, _MATERIAL_KEYS)
-    if "fit" in data and not isinstance(data["fit"], Mapping):  # a fitted file's report: kept aside
-        raise DesignError("fit", "must be an object (the report of `bushing fit`)")
-    if not isinstance(data["mode"], str):
-        raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {data['mode']!r}")
-    return Design(
-        mode=data["mode"],
-        geometry=Geometry(**data["geometry"]),
-        material=Material(**data["material"]),
-        name=data.get("name"),
-        effects=data.get("effects", {}),
-        shape=data.get("shape"),
-    )
-
-
-def _unique_keys(pairs):
-    keys = [k for k, _ in pairs]
-    repeated = sorted({k for k in keys if keys.count(k) > 1})
-    if repeated:
-        raise DesignError(repeated[0], "given twice (a design file names each key once)")
-    return dict(pairs)
-
-
-def strict_json(text: str | bytes, what: str, limit: int) -> Any:
-    """The JSON of an input file (a tolerance or targets file): at most ``limit`` characters, no
-    key given twice, not nested too deeply. Raises ValueError saying which rule ``what`` breaks."""
-    if len(text) > limit:
-        raise ValueError(f"the {what} is larger than {limit} characters ({len(text)})")
-
-    def unique(pairs):
-        keys = [k for k, _ in pairs]
-        repeated = sorted({k for k in keys if keys.count(k) > 1})
-        if repeated:
-            raise ValueError(f"the {what}: {repeated[0]} given twice (name each key once)")
-        return dict(pairs)
-
-    try:
-        return json.loads(text, object_pairs_hook=unique)
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"the {what} is not valid JSON: {exc.msg} at line {exc.lineno} column {exc.colno}") from None
-    except RecursionError:
-        raise ValueError(f"the {what} is nested too deeply") from None
-
-
-def loads_design(text: str) -> Design:
-    """A design from design-file text: JSON (no key twice, at most :data:`MAX_DESIGN_BYTES`),
-    then :func:`design_from_dict`'s rules (which refuse NaN and infinities by their key)."""
-    return loads_design_file(text)[0]
-
-
-def loads_design_file(text: str) -> tuple[Design, dict | None]:
-    """:func:`loads_design`, and the file's ``fit`` object (the report of ``bushing fit``) if it
-    has one."""
-    if len(text) > MAX_DESIGN_BYTES:
-        raise DesignError("", f"too large for a design file ({len(text)} characters; at most {MAX_DESIGN_BYTES})")
-    try:
-        data = json.loads(text, object_pairs_hook=_unique_keys)  # NaN, Infinity: refused by the key's rule
-    except json.JSONDecodeError as exc:
-        raise DesignError("", f"not valid JSON: {exc.msg} at line {exc.lineno} column {exc.colno}")
-    except RecursionError:
-        raise DesignError("", "not a design file: nested too deeply") from None
-    return design_from_dict(data), (data.get("fit") if isinstance(data, Mapping) else None)
-
-
-def read_design(path: str | Path) -> Design:
-    return read_design_file(path)[0]
-
-
-def read_design_file(path: str | Path) -> tuple[Design, dict | None]:
-    """A design file read once: the design and its ``fit`` object, if any."""
-    path = Path(path)
-    try:
-        if path.stat().st_size > MAX_DESIGN_BYTES:
-            raise DesignError("", f"design file {str(path)!r} is too large ({path.stat().st_size} bytes; "
-                              f"at most {MAX_DESIGN_BYTES})")
-        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark is not part of the JSON
-    except OSError as exc:
-        raise DesignError("", f"cannot read design file {str(path)!r}: {exc.strerror}")
-    except UnicodeDecodeError:
-        raise DesignError("", f"design file {str(path)!r} is not UTF-8 text")
-    try:
-        return loads_design_file(text)
-    except DesignError as exc:
-        raise DesignError(exc.key, f"{exc.rule} (in {path.name})") from None
-
-
-def dumps_design(design: Design) -> str:
-    return json.dumps(design.to_dict(), indent=2) + "\n"
-
-
-def write_design(design: Design, path: str | Path) -> None:
-    Path(path).write_text(dumps_design(design), encoding="utf-8")
 
 
 # Reference designs of the thesis (docs/model.md, "Reference data").

@@ -17,15 +17,19 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from scipy import special
 
-from .design import DesignError, Material, _number
 from .material import REFERENCE_FREQUENCY_HZ
 from .material import branch_moduli as material_branch_moduli
 from .parameters import BRANCH_PARAMETERS, BY_NAME, MODE, MODES, TRANSLATIONS, Parameter
+from .rules import DesignError
+from .rules import number as _number
+
+if TYPE_CHECKING:
+    from .design import Material
 
 
 def _branch(branch: str) -> tuple[Parameter, ...]:

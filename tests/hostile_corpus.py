@@ -7,26 +7,30 @@ of ``words``: the key, column or option and the rule broken) or :class:`Accepted
 correct result, checked by tests/test_hostile_corpus.py by its ``output`` kind: the documented
 columns or keys, finite numbers, the relations the physics fixes; ``same_as``: a run that must
 give the same result, the input without its harmless variation; ``words``: in the output).
+Those outcomes, the good design and the bad JSON numbers are tests/hostile_cases.py's.
 """
 
 from __future__ import annotations
 
 import json
 import math
-import sys
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-DESIGN = {"name": "corpus", "mode": "axial", "geometry": {"inner_radius": 0.02, "outer_radius": 0.035, "length": 0.09},
-          "material": {"shear_modulus": 2420000.0, "fractional_coefficient": 600000.0, "fractional_order": 0.2,
-                       "friction_stress_max": 19200.0, "friction_strain_half": 0.004}}
-_A, _B = DESIGN["geometry"]["inner_radius"], DESIGN["geometry"]["outer_radius"]
-STRAIN_FACTOR = 1.0 / math.sqrt(2.0 * (_B * _B - _A * _A) * math.log(_B / _A))  # ε_eq = c·x, eq 15
-# JSON texts put in place of a number
-BAD_NUMBERS = ["0", "-1", "-0.0", "1e-300", "1e300", "1" + "0" * 400, "NaN", "Infinity", "-Infinity", '"2.4e6"',
-               "null", "true", "[]", "{}", "1e-12", "4_858_578", "0x10", '""']
+from tests.hostile_cases import (
+    BAD_NUMBERS,
+    DESIGN,
+    NOT_JSON,
+    STRAIN_FACTOR,
+    Accepted,
+    Case,
+    Refused,
+    finite,
+    no,
+    parsed,
+)
+
 # CSV cells put in place of a number: what a reader of docs/files.md takes each for
 BAD_CELLS = {"": "missing", "abc": "not a number", "nan": "not finite", "inf": "not finite",
              "-inf": "not finite", "-1": -1.0, "0": 0.0, "1e300": 1e300, "1e-300": 1e-300, "1_0": "not a number",
@@ -47,56 +51,15 @@ TARGETS = {"design": DESIGN, "targets": [{"mode": "axial", "frequency_hz": 10, "
            "limits": {"outer_radius": {"max": 0.04}}}
 
 
-@dataclass(frozen=True)
-class Refused:
-    words: tuple[str, ...]
-    status: int = 2
-
-
-def no(*words: str) -> Refused:
-    return Refused(words)
-
-
-@dataclass(frozen=True)
-class Accepted:
-    output: str  # stiffness, band, loop, fit, diagnose or design
-    same_as: tuple[str, ...] | None = None
-    words: tuple[str, ...] = ()
-    rtol: float = 1e-12  # for same_as: the same computation, up to a term below round-off
-
-
-@dataclass(frozen=True)
-class Case:
-    name: str
-    argv: tuple[str, ...]
-    expect: Refused | Accepted
-
-
-_NOT_JSON = object()
-
-
-def _parsed(text: str):
-    try:
-        return json.loads(text)
-    except json.JSONDecodeError:
-        return _NOT_JSON
-
-
-def _finite(value) -> float | None:
-    """A JSON value as a finite float, or None (not a number, NaN, infinite, too large)."""
-    number = isinstance(value, (int, float)) and not isinstance(value, bool)
-    return float(value) if number and abs(value) <= sys.float_info.max else None
-
-
 def _number_rule(key: str, text: str, rule) -> tuple[str, ...] | None:
     """The refusal words of JSON ``text`` as the number ``key``, None if valid; ``rule`` gives
     the rule's word for a finite number (None: valid)."""
-    value = _parsed(text)
-    if value is _NOT_JSON:
+    value = parsed(text)
+    if value is NOT_JSON:
         return ("not valid JSON", "line 1 column")
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return (key, "must be a number")
-    v = _finite(value)
+    v = finite(value)
     word = "finite" if v is None else rule(v)
     return word and (key, word)
 
@@ -126,7 +89,7 @@ def design_cases(folder: Path, files: dict, good: Path) -> list[Case]:
     for eid, pname in EFFECT_CASES:
         for bad in BAD_NUMBERS[:10]:
             words = _number_rule(f"effects.{eid}.{pname}", bad, lambda v: "≥ 0" if v < 0 else None)
-            harmless = words is None and _finite(json.loads(bad)) < 1e-200  # a zero effect
+            harmless = words is None and finite(json.loads(bad)) < 1e-200  # a zero effect
             texts[f"effects.{eid}.{pname} = {bad[:20]}"] = (
                 json.dumps(DESIGN)[:-1] + f', "effects": {{"{eid}": {{"{pname}": {bad}}}}}}}',
                 "harmless" if harmless else words)
@@ -382,11 +345,11 @@ def _put(data: dict, where: tuple, text: str) -> str:
 
 def _tolerance_rule(where: tuple, text: str):
     """docs/files.md's tolerance file: the refusal words of ``text`` at ``where``, or None."""
-    value, name = _parsed(text), where[-1]
-    if value is _NOT_JSON:
+    value, name = parsed(text), where[-1]
+    if value is NOT_JSON:
         return ("tolerance file", "not valid JSON")
     if where[0] == "tolerances":
-        key, h = f"tolerances.{name}", _finite(value)
+        key, h = f"tolerances.{name}", finite(value)
         if h is None:
             return (key, "number")
         nominal = {**DESIGN["geometry"], **DESIGN["material"]}[name]
@@ -403,14 +366,14 @@ def _tolerance_rule(where: tuple, text: str):
 def _target_rule(where: tuple, text: str):
     """docs/files.md's targets file: the refusal words of ``text`` at ``where``, or what the
     report of a valid one holds (a |K| a millionfold off cannot be met)."""
-    value = _parsed(text)
-    if value is _NOT_JSON:
+    value = parsed(text)
+    if value is NOT_JSON:
         return ("targets file", "not valid JSON")
     key = "targets[0]." + where[-1] if where[0] == "targets" and len(where) == 3 else ".".join(where)
     if where[-1] in ("mode", "targets", "solutions"):  # none of BAD_NUMBERS is a mode, a list, 1–10
         return {"mode": ("targets[0]", "mode"), "targets": ("targets", "1 to 20"),
                 "solutions": ("solutions", "whole number")}[where[-1]]
-    v = _finite(value)
+    v = finite(value)
     if v is None:
         return (key, "min") if where[-1] == "magnitude" and isinstance(value, dict) else (key, "number")
     if v <= 0:

@@ -149,7 +149,8 @@ def test_data_of_two_modes_are_diagnosed_jointly_and_plotted_in_the_explorers_mo
     """An apparent mass on the axial rig only, with torsion data of the same compound: the tab
     names it for the axial rig, says the modes agree, plots the explorer's mode's rows, and the
     mass follows the design into the explorer, acting in axial only."""
-    from core.data import MeasuredStiffness, combined
+    from core.data import MeasuredStiffness
+    from core.io.measured import combined
 
     parts = []
     for mode, amps, effects in (("axial", AMPS, {"inertia": {"mass": 0.5}}), ("torsion", (1e-3, 1e-2), {})):

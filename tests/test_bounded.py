@@ -10,12 +10,13 @@ import pytest
 from scipy import stats
 
 from core import PAPER_B, TABLE_1
-from core.data import read_stiffness
-from core.design import read_design
 from core.identify import fit as fit_module
 from core.identify.diagnose import diagnose, summary
 from core.identify.fit import fit_global
 from core.identify.uncertainty import SIDE_EVALUATIONS, minimise, profile
+from core.io.design_file import read_design
+from core.io.measured import read_stiffness
+from core.io.targets import problem_from_dict
 from core.registry import parameter_unit
 from core.synthetic import synthetic_stiffness
 from core.whatif import target as target_module
@@ -180,7 +181,7 @@ def test_impossible_targets_are_searched_in_bounded_work(monkeypatch):
                             "magnitude": 1e6 * (1 + i) if amp == 1e-4 else 1e3 * (1 + i)})
         else:
             targets.append({"mode": mode, "frequency_hz": 1 + 10 * i, "amplitude": amp, "loss_factor": 0.05 + 0.3 * i})
-    problem = target_module.problem_from_dict({"design": PAPER_B.to_dict(), "targets": targets, "free_material": free})
+    problem = problem_from_dict({"design": PAPER_B.to_dict(), "targets": targets, "free_material": free})
     found = target_module.solve(problem)
     assert not found.feasible and "cannot be met" in found.statement
     n = len(problem.variables)

@@ -8,14 +8,8 @@ from numpy.testing import assert_allclose
 
 from cli.commands import main
 from core import PAPER_B, write_design
-from core.data import (
-    MAX_BYTES,
-    DataError,
-    MeasuredStiffness,
-    parse_loop,
-    parse_stiffness,
-    read_stiffness,
-)
+from core.data import DataError, MeasuredStiffness
+from core.io.measured import MAX_BYTES, parse_loop, parse_stiffness, read_stiffness
 
 HEAD = "frequency_hz,amplitude,magnitude,loss_factor\n"
 GOOD = HEAD + "10,1e-4,4.2e6,0.138\n20,1e-4,4.3e6,0.14\n"

@@ -7,7 +7,7 @@ import math
 import pytest
 
 from core import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material, loads_design
-from core.design import dumps_design, read_design, write_design
+from core.io.design_file import dumps_design, read_design, write_design
 
 
 def paper_b_dict():
@@ -210,7 +210,7 @@ def test_bad_effects_refused(effects, key):
 
 
 def test_every_direction_and_the_shape_round_trip():
-    from core.design import design_from_dict, dumps_design, loads_design
+    from core.io.design_file import design_from_dict, dumps_design, loads_design
 
     for mode in ("axial", "torsion", "radial", "conical"):
         for shape in (None, "finite", "long"):

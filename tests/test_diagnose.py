@@ -11,10 +11,12 @@ import pytest
 
 from cli.commands import main
 from core.bushing import shape_factor, stiffness_points
-from core.data import MeasuredStiffness, read_stiffness
-from core.design import PAPER_B, TABLE_1, design_from_dict, write_design
+from core.data import MeasuredStiffness
+from core.design import PAPER_B, TABLE_1
 from core.effects import EFFECTS
 from core.identify.diagnose import BRANCHES, OFF, describe, diagnose, noise_variance, summary
+from core.io.design_file import design_from_dict, write_design
+from core.io.measured import read_stiffness
 from core.synthetic import synthetic_stiffness
 
 NOISE = 0.005

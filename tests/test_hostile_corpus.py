@@ -41,7 +41,8 @@ import numpy as np
 import pytest
 
 from cli.main import main
-from tests.hostile_corpus import DESIGN, EFFECT_CASES, TOLERANCES, Accepted, Refused, corpus
+from tests.hostile_cases import DESIGN, Accepted, Refused
+from tests.hostile_corpus import EFFECT_CASES, TOLERANCES, corpus
 
 FOLDER = Path(tempfile.gettempdir()) / f"bushing-hostile-corpus-{os.getpid()}"
 CASES, FILES = corpus(FOLDER)

@@ -9,8 +9,9 @@ import pytest
 
 from cli.main import main
 from core import PAPER_B, write_design
-from core.data import DataError, MeasuredStiffness, combined, parse_stiffness
+from core.data import DataError, MeasuredStiffness
 from core.identify.fit import fit_global, model_stiffness, predicted, selection
+from core.io.measured import combined, parse_stiffness
 from core.registry import parameter_values
 from core.synthetic import synthetic_stiffness
 

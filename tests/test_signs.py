@@ -13,8 +13,9 @@ from numpy.testing import assert_allclose
 from app import plots
 from cli.commands import main
 from core import PAPER_B
-from core.data import DataError, parse_stiffness
-from core.design import design_from_dict
+from core.data import DataError
+from core.io.design_file import design_from_dict
+from core.io.measured import parse_stiffness
 from core.synthetic import synthetic_stiffness
 
 HEADERS = {"polar": "magnitude,loss_factor", "cartesian": "stiffness_real,stiffness_imag",

@@ -12,10 +12,10 @@ import pytest
 from scipy import stats
 
 from core import PAPER_B
-from core.data import read_stiffness
-from core.design import read_design
 from core.identify.fit import fit_global
 from core.identify.uncertainty import profile
+from core.io.design_file import read_design
+from core.io.measured import read_stiffness
 from core.registry import parameter_values
 from core.synthetic import synthetic_stiffness
 

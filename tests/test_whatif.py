@@ -13,19 +13,20 @@ from hypothesis import strategies as st
 from cli.main import main
 from core import PAPER_B, TABLE_1, stiffness, write_design
 from core.bushing import MAX_STRAIN, stiffness_points
-from core.data import loss_factor
 from core.identify.fit import fit_global
+from core.io.targets import problem_from_dict
+from core.io.tolerances import loads_tolerances
 from core.parameters import MATERIAL as PARAMETERS
 from core.registry import parameter
+from core.response import loss_factor
 from core.synthetic import synthetic_stiffness
 from core.whatif.sensitivity import elasticities, log_derivatives, sentence, value_of
-from core.whatif.target import TargetError, problem_from_dict, solve
+from core.whatif.target import TargetError, solve
 from core.whatif.tolerance import (
     FitCovariance,
     ToleranceError,
     Tolerances,
     band,
-    loads_tolerances,
     sample_stiffness,
 )
 
@@ -403,7 +404,7 @@ def test_a_band_refuses_strains_by_the_models_own_check():
     ('[' * 40000 + ']' * 40000, "nested too deeply"),
 ])
 def test_a_targets_file_is_strict_json(text, match):
-    from core.whatif.target import loads_problem
+    from core.io.targets import loads_problem
 
     with pytest.raises(TargetError, match=match):
         loads_problem(text)

@@ -38,6 +38,7 @@ from ..loops import loop_force
 from ..parameters import BRANCH_PARAMETERS, MATERIAL, Parameter
 from ..registry import parameter, parameter_unit, parameter_values, with_values
 from ..residuals import gap, gaps_by_mode, relative_residual
+from ..sampling import latin_hypercube
 from ..shape import OutsideTable
 from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS, linearised, minimise, profile
 
@@ -214,15 +215,11 @@ def _starts(problem: _Problem, n: int, seed: int = 0) -> list[np.ndarray]:
     first = problem.to_theta(problem.base)
     if n <= 1:
         return [first]
-    rng = np.random.default_rng(seed)
     starts = [first]
-    cols = []
-    for _ in problem.free:
-        cols.append(rng.permutation((np.arange(n - 1) + rng.random(n - 1)) / (n - 1)))
-    for k in range(n - 1):
+    for point in latin_hypercube(n - 1, len(problem.free), seed):
         theta = []
         for j, (name, spec) in enumerate(zip(problem.free, problem.specs)):
-            u = cols[j][k]
+            u = point[j]
             lo, hi = (math.log(b) for b in spec.bounds) if spec.log else spec.bounds
             if name == "fractional_order":
                 theta.append(0.05 + 0.75 * u)

@@ -25,9 +25,10 @@ import numpy as np
 
 from ..bushing import stiffness_points
 from ..card import CARD_MODES, card_design
-from ..data import csv_text, loss_factor
 from ..design import Design
 from ..parameters import MODE, ROTATIONS, TRANSLATIONS
+from ..response import loss_factor
+from .table import csv_text
 
 MAX_EXPORT_POINTS = 100_000  # frequencies × amplitudes of one export
 

@@ -17,9 +17,9 @@ import math
 import numpy as np
 
 from ..bushing import stiffness_points
-from ..data import loss_factor
 from ..design import Design
 from ..parameters import BY_NAME, NAMES
+from ..response import loss_factor
 
 STEP = 1e-4  # the step in ln p of the central differences
 

@@ -15,7 +15,8 @@ each, and no new start once :data:`TARGET_EVALUATIONS` evaluations of a target h
 
 A target is a quantity at an operating point (mode, frequency, amplitude): ``magnitude`` |K|,
 ``loss_factor`` η, or for a ``ratio`` of two modes |K₁|/|K₂|. Its value is a number (met within
-± ``tolerance``, relative) or a range ``{"min": …, "max": …}``. ``docs/files.md`` gives the file.
+± ``tolerance``, relative) or a range ``{"min": …, "max": …}``. ``docs/files.md`` gives the file,
+:mod:`core.io.targets` reads it.
 """
 
 from __future__ import annotations
@@ -23,27 +24,20 @@ from __future__ import annotations
 import json
 import math
 import time
-from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares, minimize
 
 from ..bushing import MAX_STRAIN, stiffness_points
-from ..data import loss_factor
-from ..design import SIZE_RANGE, Design, DesignError, design_from_dict, strict_json
-from ..parameters import GEOMETRY, MATERIAL, MODE, MODES
-from ..registry import parameter
+from ..design import Design, DesignError
+from ..parameters import GEOMETRY, MODE
+from ..response import loss_factor
+from ..rules import RuleError
+from ..sampling import latin_hypercube
 
-QUANTITIES = ("magnitude", "loss_factor")
-GEOMETRY_LIMITS = (*GEOMETRY, "thickness")  # a, b, L and the rubber's thickness b − a
 SEARCHED = tuple("thickness" if n == "outer_radius" else n for n in GEOMETRY)  # a, t = b − a, L
-DEFAULT_LIMITS = {"inner_radius": (1e-3, 1.0), "outer_radius": (2e-3, 1.0), "length": (1e-3, 1.0),
-                  "thickness": (1e-3, 1.0)}
-TOLERANCE = 0.01  # a numeric target is met within ±1 % unless the file says otherwise
-MAX_TARGETS, MAX_SOLUTIONS, STARTS = 20, 10, 12
-FREQUENCY_RANGE = (1e-4, 1e5)
+STARTS = 12
 FEASIBLE = 1e-6  # a constraint counts as met down to this (in logarithms)
 # SLSQP iterations from one start: feasible searches converge in at most 15, an impossible one
 # gives up (status 8) within 75
@@ -53,12 +47,11 @@ CLOSEST_NFEV = 100  # least-squares iterations from each of the closest miss's s
 # evaluations of one target at one design (a few stiffnesses, about 0.1 ms): no new start once
 # a search has spent these; the start under way adds at most MAX_ITERATIONS (n + 2) per target
 TARGET_EVALUATIONS = 20_000
-MAX_FILE_BYTES = 1_000_000
-_FILE_KEYS = ("design", "targets", "tolerance", "limits", "free_material", "fixed", "solutions")
 
 
-class TargetError(ValueError):
-    """A targets file that cannot be used, with the reason in plain words."""
+class TargetError(RuleError):
+    """A targets file that cannot be used: ``key`` names where, ``rule`` the reason in plain
+    words, ``code`` the rule (:mod:`core.rules`)."""
 
 
 @dataclass(frozen=True)
@@ -111,7 +104,7 @@ class Target:
 
 @dataclass(frozen=True)
 class Problem:
-    """A start design, its targets, the limits (SI, by :data:`GEOMETRY_LIMITS`) and the
+    """A start design, its targets, the limits (SI, by :data:`core.io.targets.GEOMETRY_LIMITS`) and the
     material parameters left free within ranges."""
 
     start: Design
@@ -247,11 +240,11 @@ class _Evaluator:
 
 
 def _starts(problem: Problem, n: int, seed: int = 0) -> list[np.ndarray]:
+    """The start design (within the limits), then ``n − 1`` points of a seeded Latin hypercube
+    over the limits (in logarithms)."""
     lo, hi = problem.bounds()
     first = np.clip(np.log([problem.values(problem.start)[v] for v in problem.variables]), lo, hi)
-    rng = np.random.default_rng(seed)
-    cols = [rng.permutation((np.arange(n - 1) + rng.random(n - 1)) / (n - 1)) for _ in problem.variables]
-    return [first] + [lo + (hi - lo) * np.array([c[k] for c in cols]) for k in range(n - 1)]
+    return [first] + list(lo + (hi - lo) * latin_hypercube(n - 1, len(problem.variables), seed))
 
 
 def _binding(problem: Problem, z: np.ndarray, design: Design) -> tuple[str, ...]:
@@ -375,142 +368,3 @@ def _why(problem: Problem, closest: Solution) -> str:
     else:
         cause = "no limit binds there: the targets contradict each other"
     return f"The targets cannot be met. At the closest design, {'; '.join(missed)}; {cause}."
-
-
-# ---- the targets file --------------------------------------------------------------------------------
-
-
-def _number(key: str, value: Any, positive: bool = True) -> float:
-    try:
-        finite = not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
-    except OverflowError:  # an integer past 1e308
-        finite = False
-    if not finite:
-        raise TargetError(f"{key}: must be a finite number, got {str(value)[:40]}")
-    if positive and value <= 0:
-        raise TargetError(f"{key}: must be positive, got {value!r}")
-    return float(value)
-
-
-def _range(key: str, spec: Any) -> tuple[float | None, float | None]:
-    if not isinstance(spec, Mapping) or not spec or any(k not in ("min", "max") for k in spec):
-        raise TargetError(f"{key}: give a number or an object with min and/or max")
-    low = _number(f"{key}.min", spec["min"]) if "min" in spec else None
-    high = _number(f"{key}.max", spec["max"]) if "max" in spec else None
-    if low is not None and high is not None and low > high:
-        raise TargetError(f"{key}: min {low:g} is above max {high:g}")
-    return low, high
-
-
-def _ranges(key: str, spec: Any, known: tuple[str, ...]) -> dict[str, tuple[float | None, float | None]]:
-    """An object of name → {min, max}, its names from ``known``."""
-    if not isinstance(spec, Mapping):
-        raise TargetError(f"{key}: an object of name → {{min, max}}")
-    unknown = [n for n in spec if n not in known]
-    if unknown:
-        raise TargetError(f"{key}.{unknown[0]}: unknown (known: {', '.join(known)})")
-    return {name: _range(f"{key}.{name}", r) for name, r in spec.items()}
-
-
-def _target(i: int, spec: Any, tolerance: float, start: Design) -> Target:
-    key = f"targets[{i}]"
-    if not isinstance(spec, Mapping):
-        raise TargetError(f"{key}: must be an object")
-    allowed = ("mode", "ratio", "frequency_hz", "amplitude", "amplitudes", "magnitude", "loss_factor", "tolerance")
-    unknown = [k for k in spec if k not in allowed]
-    if unknown:
-        raise TargetError(f"{key}.{unknown[0]}: unknown key (allowed: {', '.join(allowed)})")
-    if ("mode" in spec) == ("ratio" in spec):
-        raise TargetError(f"{key}: give either mode (one direction) or ratio (two)")
-    modes = [spec["mode"]] if "mode" in spec else spec["ratio"]
-    if not isinstance(modes, list) or len(modes) != (1 if "mode" in spec else 2) or any(m not in MODES for m in modes):
-        raise TargetError(f"{key}: mode is one of {', '.join(MODES)}; ratio is a list of two of them")
-    if "ratio" in spec and modes[0] == modes[1]:
-        raise TargetError(f"{key}.ratio: two different modes")
-    f = _number(f"{key}.frequency_hz", spec.get("frequency_hz"))
-    if not FREQUENCY_RANGE[0] <= f <= FREQUENCY_RANGE[1]:
-        raise TargetError(f"{key}.frequency_hz: from {FREQUENCY_RANGE[0]:g} to {FREQUENCY_RANGE[1]:g} Hz, got {f:g}")
-    if "amplitudes" in spec:
-        amps = spec["amplitudes"]
-        if not isinstance(amps, list) or len(amps) != len(modes):
-            raise TargetError(f"{key}.amplitudes: one amplitude per mode ({len(modes)})")
-        amps = [_number(f"{key}.amplitudes[{j}]", a) for j, a in enumerate(amps)]
-    else:
-        amps = [_number(f"{key}.amplitude", spec.get("amplitude"))] * len(modes)
-    if len(modes) == 2 and "amplitudes" not in spec and MODE[modes[0]].amplitude.si != MODE[modes[1]].amplitude.si:
-        raise TargetError(f"{key}: {modes[0]} and {modes[1]} are driven in different units: give amplitudes, one per mode")
-    quantities = [q for q in QUANTITIES if q in spec]
-    if len(quantities) != 1 or (len(modes) == 2 and quantities != ["magnitude"]):
-        raise TargetError(f"{key}: give one of magnitude or loss_factor (a ratio takes magnitude)")
-    quantity = quantities[0]
-    tol = _number(f"{key}.tolerance", spec["tolerance"]) if "tolerance" in spec else tolerance
-    value = spec[quantity]
-    if isinstance(value, Mapping):
-        low, high = _range(f"{key}.{quantity}", value)
-        number = None
-    else:
-        number = _number(f"{key}.{quantity}", value)
-        low, high = number * (1 - tol), number * (1 + tol)
-    for m, x in zip(modes, amps):
-        try:
-            stiffness_points(start.in_mode(m), f, x)
-        except ValueError as exc:
-            raise TargetError(f"{key}: {exc}") from None
-    return Target(tuple(modes), quantity, f, tuple(amps), low, high, number)
-
-
-def problem_from_dict(data: Any) -> Problem:
-    """The targets file's object (``docs/files.md``)."""
-    if not isinstance(data, Mapping):
-        raise TargetError("the targets file must hold a JSON object")
-    unknown = [k for k in data if k not in _FILE_KEYS]
-    if unknown:
-        raise TargetError(f"{unknown[0]}: unknown key (allowed: {', '.join(_FILE_KEYS)})")
-    if "design" not in data:
-        raise TargetError("design: missing (the starting design, a design-file object)")
-    try:
-        start = design_from_dict(data["design"])
-    except DesignError as exc:
-        raise TargetError(f"design.{exc}") from None
-    tolerance = _number("tolerance", data.get("tolerance", TOLERANCE))
-    if tolerance >= 1:
-        raise TargetError(f"tolerance: a fraction below 1, got {tolerance:g}")
-    targets = data.get("targets")
-    if not isinstance(targets, list) or not 1 <= len(targets) <= MAX_TARGETS:
-        raise TargetError(f"targets: a list of 1 to {MAX_TARGETS} targets")
-    parsed = tuple(_target(i, t, tolerance, start) for i, t in enumerate(targets))
-    limits = dict(DEFAULT_LIMITS)
-    for name, (low, high) in _ranges("limits", data.get("limits", {}), GEOMETRY_LIMITS).items():
-        low = DEFAULT_LIMITS[name][0] if low is None else low
-        high = DEFAULT_LIMITS[name][1] if high is None else high
-        if not SIZE_RANGE[0] <= low < high <= SIZE_RANGE[1]:
-            raise TargetError(f"limits.{name}: min < max, both within {SIZE_RANGE[0]:g}–{SIZE_RANGE[1]:g} m")
-        limits[name] = (low, high)
-    fixed = data.get("fixed", [])
-    if not isinstance(fixed, list) or any(n not in SEARCHED for n in fixed):
-        raise TargetError(f"fixed: a list of {', '.join(SEARCHED)} (held at the start design's)")
-    free = {}
-    for name, (low, high) in _ranges("free_material", data.get("free_material", {}), MATERIAL).items():
-        p_lo, p_hi = parameter(name).bounds  # within the fitting range (α also ≤ 1)
-        low, high = max(low or p_lo, p_lo, 1e-30), min(high or p_hi, p_hi, 1.0 if name == "fractional_order" else math.inf)
-        if not low < high:
-            raise TargetError(f"free_material.{name}: an empty range")
-        free[name] = (low, high)
-    n = data.get("solutions", 3)
-    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_SOLUTIONS:
-        raise TargetError(f"solutions: a whole number from 1 to {MAX_SOLUTIONS}")
-    # the fixed variables must lie within their limits
-    values = Problem(start, parsed, limits, free, tuple(fixed)).values(start)
-    for name in fixed:
-        lo, hi = limits[name]
-        if not lo <= values[name] <= hi:
-            raise TargetError(f"fixed: {name} of the start design ({values[name]:.4g} m) is outside its limits")
-    return Problem(start, parsed, limits, free, tuple(fixed), n)
-
-
-def loads_problem(text: str | bytes) -> Problem:
-    try:
-        data = strict_json(text, "targets file", MAX_FILE_BYTES)
-    except ValueError as exc:
-        raise TargetError(str(exc)) from None
-    return problem_from_dict(data)

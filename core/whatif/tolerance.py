@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import functools
 import math
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import SimpleNamespace
@@ -38,12 +37,26 @@ from ..bushing import (
     stiffness_points,
     strain_factor,
 )
-from ..data import loss_factor
-from ..design import Design, DesignError, Geometry, strict_json
+from ..design import Design, DesignError, Geometry
 from ..identify.fit import FitResult
 from ..material import equivalent_modulus
 from ..parameters import GEOMETRY, MATERIAL, NAMES
 from ..registry import parameter
+from ..response import loss_factor
+from ..rules import (
+    BAD_CHOICE,
+    DUPLICATE_KEY,
+    MISSING_KEY,
+    NEGATIVE,
+    NOT_A_NUMBER,
+    NOT_FINITE,
+    OUT_OF_RANGE,
+    OUTER_NOT_LARGER,
+    UNKNOWN_KEY,
+    RuleError,
+    is_number,
+    whole_number,
+)
 from .sensitivity import log_derivatives, value_of
 
 DISTRIBUTIONS = ("uniform", "normal")
@@ -52,15 +65,14 @@ SAMPLE_RANGE = (10, 5000)
 PERCENTILES = (5.0, 50.0, 95.0)
 MAX_RELATIVE = 0.9  # a tolerance of ±90 % or more is no tolerance
 MAX_EVALUATIONS = 20_000_000  # samples × points of one band
-MAX_FILE_BYTES = 100_000
 _TRUNCATED = stats.truncnorm(-3.0, 3.0)
 _UNIT_STD = {"uniform": 1.0 / math.sqrt(3.0), "normal": float(_TRUNCATED.std()) / 3.0}  # of u in [−1, 1]
 _FIT_KEYS = ("standard_errors", "correlation")
-_PERCENT = re.compile(r"^\s*([0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?\s*%\s*$")
 
 
-class ToleranceError(ValueError):
-    """A tolerance specification that cannot be used, with the reason in plain words."""
+class ToleranceError(RuleError):
+    """A tolerance specification that cannot be used: ``key`` names where, ``rule`` the reason
+    in plain words, ``code`` the rule (:mod:`core.rules`)."""
 
 
 @dataclass(frozen=True)
@@ -79,37 +91,29 @@ class FitCovariance:
     def from_report(cls, report: Any) -> FitCovariance:
         """From the ``fit`` object of a fitted design file."""
         if not isinstance(report, Mapping) or any(not isinstance(report.get(k), Mapping) for k in _FIT_KEYS):
-            raise ToleranceError("fit_covariance: the design file has no fit report (standard_errors and "
-                                 "correlation); give the output of `bushing fit`")
+            raise ToleranceError("fit_covariance", "the design file has no fit report (standard_errors and "
+                                 "correlation); give the output of `bushing fit`", MISSING_KEY)
         return cls(dict(report["standard_errors"]), {k: dict(v) for k, v in report["correlation"].items()})
 
     def matrix(self, design: Design) -> tuple[tuple[str, ...], np.ndarray]:
         """The material parameters and their covariance in the fit's coordinates."""
         names = tuple(n for n in self.standard_errors if n in NAMES)
-        vague = [n for n in names if not _finite(self.standard_errors[n])]
+        vague = [n for n in names if not is_number(self.standard_errors[n])]
         if vague:
-            raise ToleranceError(f"fit_covariance: the fit does not determine {', '.join(vague)} (no standard error): "
-                                 "its covariance cannot make a band; give a tolerance for it instead")
+            raise ToleranceError("fit_covariance", f"the fit does not determine {', '.join(vague)} (no standard "
+                                 "error): its covariance cannot make a band; give a tolerance for it instead", NOT_FINITE)
         if not names:
-            raise ToleranceError("fit_covariance: the fit report holds no material parameter")
+            raise ToleranceError("fit_covariance", "the fit report holds no material parameter", MISSING_KEY)
         sd = np.array([self.standard_errors[n] / (value_of(design, n) if parameter(n).log else 1.0) for n in names])
         try:
             corr = np.array([[float(self.correlation[a][b]) for b in names] for a in names])
         except (KeyError, TypeError, ValueError):
-            raise ToleranceError("fit_covariance: the fit's correlation does not cover its parameters") from None
+            raise ToleranceError("fit_covariance", "the fit's correlation does not cover its parameters",
+                                 MISSING_KEY) from None
         if not np.all(np.isfinite(corr)):
-            raise ToleranceError("fit_covariance: the fit's correlation is not defined (a degenerate fit)")
+            raise ToleranceError("fit_covariance", "the fit's correlation is not defined (a degenerate fit)",
+                                 NOT_FINITE)
         return names, corr * np.outer(sd, sd)
-
-
-def _finite(v) -> bool:
-    """A number that a float holds (not a bool, NaN, an infinity, or an integer past 1e308)."""
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        return False
-    try:
-        return math.isfinite(v)
-    except OverflowError:
-        return False
 
 
 @dataclass(frozen=True)
@@ -130,26 +134,31 @@ class Tolerances:
     def __post_init__(self):
         for kind, values in (("relative", self.relative), ("absolute", self.absolute)):
             for name, h in values.items():
+                key = f"tolerances.{name}"
                 if name not in NAMES:
-                    raise ToleranceError(f"tolerances.{name}: unknown parameter (known: {', '.join(NAMES)})")
-                if not _finite(h) or h < 0:
-                    raise ToleranceError(f"tolerances.{name}: must be a number ≥ 0, got {str(h)[:40]}")
+                    raise ToleranceError(key, f"unknown parameter (known: {', '.join(NAMES)})",
+                                         UNKNOWN_KEY)
+                if not is_number(h) or h < 0:
+                    raise ToleranceError(key, f"must be a number ≥ 0, got {str(h)[:40]}",
+                                         NEGATIVE if is_number(h) else NOT_A_NUMBER)
                 if kind == "relative" and h >= MAX_RELATIVE:
-                    raise ToleranceError(f"tolerances.{name}: ±{100 * h:g} % is not a tolerance (at most "
-                                         f"{100 * MAX_RELATIVE:g} %)")
+                    raise ToleranceError(key, f"±{100 * h:g} % is not a tolerance (at most {100 * MAX_RELATIVE:g} %)",
+                                         OUT_OF_RANGE)
         both = set(self.relative) & set(self.absolute)
         if both:
-            raise ToleranceError(f"tolerances.{min(both)}: given twice (relative and absolute)")
+            raise ToleranceError(f"tolerances.{min(both)}", "given twice (relative and absolute)", DUPLICATE_KEY)
         if self.distribution not in DISTRIBUTIONS:
-            raise ToleranceError(f"distribution: must be one of {', '.join(DISTRIBUTIONS)}, got {str(self.distribution)[:40]}")
-        if isinstance(self.samples, bool) or not isinstance(self.samples, int) or \
-                not SAMPLE_RANGE[0] <= self.samples <= SAMPLE_RANGE[1]:
-            raise ToleranceError(f"samples: a whole number from {SAMPLE_RANGE[0]} to {SAMPLE_RANGE[1]}, got {str(self.samples)[:40]}")
-        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or not 0 <= self.seed < 2**63:
-            raise ToleranceError(f"seed: a whole number from 0 to 2^63 − 1, got {str(self.seed)[:40]}")
-        if not self.percentiles or any(not _finite(q) or not 0 <= q <= 100 for q in self.percentiles) or \
+            raise ToleranceError("distribution", f"must be one of {', '.join(DISTRIBUTIONS)}, got "
+                                 f"{str(self.distribution)[:40]}", BAD_CHOICE)
+        if code := whole_number(self.samples, *SAMPLE_RANGE):
+            raise ToleranceError("samples", f"a whole number from {SAMPLE_RANGE[0]} to {SAMPLE_RANGE[1]}, got "
+                                 f"{str(self.samples)[:40]}", code)
+        if code := whole_number(self.seed, 0, 2**63 - 1):
+            raise ToleranceError("seed", f"a whole number from 0 to 2^63 − 1, got {str(self.seed)[:40]}", code)
+        if not self.percentiles or any(not is_number(q) or not 0 <= q <= 100 for q in self.percentiles) or \
                 len(self.percentiles) > 9:
-            raise ToleranceError(f"percentiles: one to nine numbers from 0 to 100, got {str(list(self.percentiles))[:60]}")
+            raise ToleranceError("percentiles", f"one to nine numbers from 0 to 100, got "
+                                 f"{str(list(self.percentiles))[:60]}", OUT_OF_RANGE)
 
     @property
     def varied(self) -> bool:
@@ -169,19 +178,21 @@ class Tolerances:
             names, _ = self.covariance.matrix(design)
             twice = sorted(set(names) & set(h))
             if twice:
-                raise ToleranceError(f"tolerances.{twice[0]}: given twice (a tolerance and the fit's covariance)")
+                raise ToleranceError(f"tolerances.{twice[0]}", "given twice (a tolerance and the fit's covariance)",
+                                     DUPLICATE_KEY)
         a_high = design.geometry.inner_radius + h.get("inner_radius", 0.0)
         b_low = design.geometry.outer_radius - h.get("outer_radius", 0.0)
         if a_high >= b_low:
-            raise ToleranceError(f"tolerances: a may reach {a_high:.4g} m and b fall to {b_low:.4g} m: "
-                                 "some parts would have no rubber (b ≤ a)")
+            raise ToleranceError("tolerances", f"a may reach {a_high:.4g} m and b fall to {b_low:.4g} m: "
+                                 "some parts would have no rubber (b ≤ a)", OUTER_NOT_LARGER)
         for name, width in h.items():
             low, high = value_of(design, name) - width, value_of(design, name) + width
             try:
                 design.replace(**{name: low})
                 design.replace(**{name: high})
             except DesignError as exc:
-                raise ToleranceError(f"tolerances.{name}: ±{width:.4g} takes it outside its range ({exc.rule})") from None
+                raise ToleranceError(f"tolerances.{name}", f"±{width:.4g} takes it outside its range ({exc.rule})",
+                                     OUT_OF_RANGE) from None
 
     def draws(self, design: Design) -> list[dict[str, float]]:
         """The sampled parameter values (only those that vary), one mapping per sample."""
@@ -358,61 +369,6 @@ def first_order(design: Design, frequency_hz, amplitude, tolerances: Tolerances,
         g = np.stack([np.broadcast_to(d[n][j], shape) for n in names], axis=-1)
         out.append(np.sqrt(np.maximum(np.einsum("...i,ij,...j->...", g, cov, g), 0.0)))
     return out[0], out[1]
-
-
-# ---- the tolerance file ------------------------------------------------------------------------
-
-_FILE_KEYS = ("tolerances", "distribution", "samples", "seed", "percentiles", "fit_covariance")
-
-
-def _spread(name: str, value: Any) -> tuple[str, float]:
-    """"10%" → relative 0.1; a number → absolute (SI)."""
-    if isinstance(value, str):
-        m = _PERCENT.match(value)
-        if not m:
-            raise ToleranceError(f"tolerances.{name}: give a percentage such as \"10%\" or a number in SI units, "
-                                 f"got {str(value)[:40]}")
-        return "relative", float(value.strip().rstrip("%")) / 100.0
-    if not _finite(value):
-        raise ToleranceError(f"tolerances.{name}: give a percentage such as \"10%\" or a number in SI units, got {str(value)[:40]}")
-    return "absolute", float(value)
-
-
-def tolerances_from_dict(data: Any, fit_report: Any = None) -> Tolerances:
-    """The tolerance file's object (``docs/files.md``); ``fit_report`` the design file's ``fit``
-    object, used when ``fit_covariance`` is true."""
-    if not isinstance(data, Mapping):
-        raise ToleranceError("the tolerance file must hold a JSON object")
-    unknown = [k for k in data if k not in _FILE_KEYS]
-    if unknown:
-        raise ToleranceError(f"{unknown[0]}: unknown key (allowed: {', '.join(_FILE_KEYS)})")
-    spreads = data.get("tolerances", {})
-    if not isinstance(spreads, Mapping):
-        raise ToleranceError("tolerances: must be an object of parameter → tolerance")
-    relative, absolute = {}, {}
-    for name, value in spreads.items():
-        kind, h = _spread(str(name), value)
-        (relative if kind == "relative" else absolute)[str(name)] = h
-    use_fit = data.get("fit_covariance", False)
-    if not isinstance(use_fit, bool):
-        raise ToleranceError(f"fit_covariance: true or false, got {str(use_fit)[:40]}")
-    percentiles = data.get("percentiles", list(PERCENTILES))
-    if not isinstance(percentiles, list):
-        raise ToleranceError(f"percentiles: a list of numbers from 0 to 100, got {str(percentiles)[:60]}")
-    tol = Tolerances(relative, absolute, data.get("distribution", "uniform"), data.get("samples", SAMPLES),
-                     data.get("seed", 0), tuple(percentiles),
-                     FitCovariance.from_report(fit_report) if use_fit else None)
-    if not tol.varied:
-        raise ToleranceError("tolerances: nothing varies (give at least one tolerance above 0, or fit_covariance)")
-    return tol
-
-
-def loads_tolerances(text: str | bytes, fit_report: Any = None) -> Tolerances:
-    try:
-        data = strict_json(text, "tolerance file", MAX_FILE_BYTES)
-    except ValueError as exc:
-        raise ToleranceError(str(exc)) from None
-    return tolerances_from_dict(data, fit_report)
 
 
 def band_columns(b: Band) -> dict[str, np.ndarray]:

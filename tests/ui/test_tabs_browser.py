@@ -78,7 +78,7 @@ def test_upload_fit_and_use(page, explorer_url, tmp_path):
 def test_an_oversized_file_is_refused_in_the_browser(page, explorer_url, tmp_path):
     """A 21 MB file (valid rows) is refused by the drop area with the limit in its message,
     before anything is sent; the session goes on and takes the next file."""
-    from core.data import MAX_BYTES
+    from core.io.measured import MAX_BYTES
 
     row = "10,0.0001,4200000.0000000000,0.1400000000000000\n"
     big = tmp_path / "big.csv"

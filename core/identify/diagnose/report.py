@@ -8,8 +8,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ...data import MeasuredStiffness, loss_factor
+from ...data import MeasuredStiffness
 from ...design import Design
+from ...response import loss_factor
 from ..fit import FitResult
 from .model import Model
 from .statistics import BIC_THRESHOLD

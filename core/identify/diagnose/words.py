@@ -7,8 +7,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ...data import MeasuredStiffness, loss_factor, magnitude_residual_pct
+from ...data import MeasuredStiffness
 from ...parameters import MODE
+from ...response import loss_factor, magnitude_residual_pct
 
 
 def _bins(values: np.ndarray, most: int = 8) -> tuple[np.ndarray, list[tuple[float, float]]]:

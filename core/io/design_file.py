@@ -1,0 +1,106 @@
+"""The design file (docs/files.md): JSON of a :class:`core.design.Design`, read strictly and
+written back, with the report of ``bushing fit`` kept aside when a fitted file has one.
+
+Every refusal is a :class:`core.rules.DesignError` naming the key and the rule (and its code).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from ..design import Design, Geometry, Material
+from ..parameters import GEOMETRY, MATERIAL, MODES
+from ..rules import (
+    BAD_CHOICE,
+    BAD_TYPE,
+    MISSING_KEY,
+    UNKNOWN_KEY,
+    DesignError,
+    Words,
+    read_text,
+    strict_json,
+)
+
+MAX_DESIGN_BYTES = 1_000_000  # a design file is a few hundred bytes; one of a megabyte is not one
+_TOP_KEYS = ("name", "mode", "shape", "geometry", "material", "effects", "fit")
+_WORDS = Words(
+    too_large="design file {path!r} is too large ({size} bytes; at most {limit})",
+    unreadable="cannot read design file {path!r}: {reason}",
+    not_utf8="design file {path!r} is not UTF-8 text",
+    too_long="too large for a design file ({size} characters; at most {limit})",
+    twice="given twice (a design file names each key once)",
+    bad_json="not valid JSON: {msg} at line {line} column {column}",
+    too_deep="not a design file: nested too deeply",
+    key_twice=True,
+)
+
+
+def _exact_keys(where: str, obj: Any, allowed: tuple[str, ...], required: tuple[str, ...]):
+    if not isinstance(obj, Mapping):
+        raise DesignError(where, f"must be an object with keys {', '.join(allowed)}", BAD_TYPE)
+    prefix = f"{where}." if where else ""
+    for key in obj:
+        if key not in allowed:
+            raise DesignError(f"{prefix}{key}", f"unknown key (allowed: {', '.join(allowed)})", UNKNOWN_KEY)
+    for key in required:
+        if key not in obj:
+            raise DesignError(f"{prefix}{key}", "missing (required)", MISSING_KEY)
+
+
+def design_from_dict(data: Any) -> Design:
+    """Build a :class:`Design` from a design-file object (docs/files.md), refusing anything off."""
+    _exact_keys("", data, _TOP_KEYS, ("mode", "geometry", "material"))
+    _exact_keys("geometry", data["geometry"], GEOMETRY, GEOMETRY)
+    _exact_keys("material", data["material"], MATERIAL, MATERIAL)
+    if "fit" in data and not isinstance(data["fit"], Mapping):  # a fitted file's report: kept aside
+        raise DesignError("fit", "must be an object (the report of `bushing fit`)", BAD_TYPE)
+    if not isinstance(data["mode"], str):
+        raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {data['mode']!r}", BAD_CHOICE)
+    return Design(
+        mode=data["mode"],
+        geometry=Geometry(**data["geometry"]),
+        material=Material(**data["material"]),
+        name=data.get("name"),
+        effects=data.get("effects", {}),
+        shape=data.get("shape"),
+    )
+
+
+def loads_design(text: str) -> Design:
+    """A design from design-file text: strict JSON (no key twice, at most
+    :data:`MAX_DESIGN_BYTES` characters), then :func:`design_from_dict`'s rules (which refuse
+    NaN and infinities by their key)."""
+    return loads_design_file(text)[0]
+
+
+def loads_design_file(text: str) -> tuple[Design, dict | None]:
+    """:func:`loads_design`, and the file's ``fit`` object (the report of ``bushing fit``) if it
+    has one."""
+    data = strict_json(text, MAX_DESIGN_BYTES, _WORDS, DesignError)
+    return design_from_dict(data), (data.get("fit") if isinstance(data, Mapping) else None)
+
+
+def read_design(path: str | Path) -> Design:
+    return read_design_file(path)[0]
+
+
+def read_design_file(path: str | Path) -> tuple[Design, dict | None]:
+    """A design file read once (at most :data:`MAX_DESIGN_BYTES` bytes of UTF-8): the design and
+    its ``fit`` object, if any; a refusal of its content names the file."""
+    path = Path(path)
+    text = read_text(path, MAX_DESIGN_BYTES, _WORDS, DesignError)
+    try:
+        return loads_design_file(text)
+    except DesignError as exc:
+        raise DesignError(exc.key, f"{exc.rule} (in {path.name})", exc.code) from None
+
+
+def dumps_design(design: Design) -> str:
+    return json.dumps(design.to_dict(), indent=2) + "\n"
+
+
+def write_design(design: Design, path: str | Path) -> None:
+    Path(path).write_text(dumps_design(design), encoding="utf-8")
