@@ -16,6 +16,7 @@ from core import PAPER_B, Design, DesignError, Geometry, Material
 from core.bushing import factors
 from core.design import SIZE_RANGE, as_dict
 from core.parameters import BY_NAME, GEOMETRY, MATERIAL, PARAMETERS, DesignParameter
+from core.rules import NOT_POSITIVE, ORDER_RANGE, OUTER_NOT_LARGER
 
 # field name → its design parameter, in the table's order (geometry, then material)
 DESIGN_FIELDS: dict[str, DesignParameter] = {p.field: p for p in PARAMETERS}
@@ -88,16 +89,22 @@ def design_from_fields(fields: Mapping, shown: Design, mode: str, shape: str | N
     return design, {}
 
 
+# what the input panel says for a rule, by the rule's code (core.rules): the panel's own words
+PANEL_WORDS = {
+    OUTER_NOT_LARGER: "Must be larger than the inner radius a.",
+    NOT_POSITIVE: "Must be positive.",
+    ORDER_RANGE: "Must lie in (0, 1].",
+}
+
+
 def _plain(exc: DesignError) -> str:
-    """A design error in the words of the input panel (mm, MPa) rather than the file's keys."""
+    """A design error in the words of the input panel: by its rule code where the panel has its
+    own words, else the core's rule with the file's keys (``material.shear_modulus``) replaced by
+    the panel's names."""
+    if exc.code in PANEL_WORDS:
+        return PANEL_WORDS[exc.code]
     rule = exc.rule
     for name, key in ((p.field, p.name) for p in PARAMETERS):
         rule = rule.replace(f"geometry.{key}", name).replace(f"material.{key}", name)
-    rule = rule.replace("outer_radius_mm", "b").replace("inner_radius_mm", "a")
-    if "b > a" in rule:
-        return "Must be larger than the inner radius a."
-    if "must be positive" in rule:
-        return "Must be positive."
-    if "(0, 1]" in rule:
-        return "Must lie in (0, 1]."
+    rule = rule.replace(BY_NAME["outer_radius"].field, "b").replace(BY_NAME["inner_radius"].field, "a")
     return rule[0].upper() + rule[1:]

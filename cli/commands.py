@@ -9,7 +9,6 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import math
-import re
 import sys
 import time
 import warnings
@@ -17,15 +16,16 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from core.bushing import MAX_SLICES, slice_count, stiffness
+from core.bushing import MAX_SLICES, ROUTES, slice_count, stiffness
 from core.data import DataError
 from core.io.design_file import read_design, read_design_file
+from core.io.export import FORMATS, export
 from core.io.measured import MAX_ROWS, combined, read_loop, read_stiffness
 from core.io.table import csv_text
 from core.loops import loop
 from core.material import ConvergenceError
 from core.parameters import BRANCH_PARAMETERS, MODE, ROTATIONS, TRANSLATIONS
-from core.rules import DECIMAL, OVERFLOW, DesignError, RuleError, decimal
+from core.rules import DECIMAL, OVERFLOW, WHOLE, DesignError, RuleError, decimal
 
 NUMBER_FORMAT = "{:.12g}"
 # the largest sizes the command line computes (docs/files.md): a grid of at most a million
@@ -65,7 +65,7 @@ def _positive(name):
 
 def _count(name, minimum=1, maximum=None):
     def parse(text: str) -> int:
-        if not re.fullmatch(r"[-+]?\d+", str(text).strip()):
+        if not WHOLE.fullmatch(str(text).strip()):
             raise argparse.ArgumentTypeError(f"{name} must be a whole number, got {text!r}")
         value = int(text)
         if value < minimum:
@@ -112,7 +112,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     st.add_argument(
         "--route",
-        choices=("analytic", "time-domain"),
+        choices=ROUTES,
         default="analytic",
         help="analytic steady state (default, fast) or the thesis' time-domain simulation",
     )
@@ -199,7 +199,7 @@ def build_parser() -> argparse.ArgumentParser:
         "every direction is taken at the same equivalent strains (docs/export.md).",
     )
     _grid_arguments(ex, "amplitudes in the design's mode, m or rad")
-    ex.add_argument("--format", required=True, choices=("table", "nastran", "adams"), help="the file to write")
+    ex.add_argument("--format", required=True, choices=FORMATS, help="the file to write")
     ex.add_argument("-o", dest="output", metavar="OUT", help="write here, not to stdout")
 
     dz = sub.add_parser(
@@ -445,7 +445,6 @@ def _cmd_card(args) -> None:
 
 
 def _cmd_export(args) -> None:
-    from core.io.export import export
 
     try:
         freqs = _frequencies(args)

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any
 
 from .effects import EFFECTS, validate_effects
-from .parameters import DEFAULT_SHAPE, MODES, SHAPES
+from .parameters import BY_NAME, DEFAULT_SHAPE, MODES, SHAPES, no_long_form
 from .rules import (
     BAD_CHOICE,
     BAD_TYPE,
@@ -33,7 +33,7 @@ from .shape import shape_factor, strain_factor
 # shape factors: closed forms of long bushings (the thesis'), or finite-length FE (core/shape.py)
 SIZE_RANGE = (1e-6, 1e3)  # m: radii and lengths from a micrometre to a kilometre, no further
 MAX_MODULUS = 1e12  # Pa: µ, m and σ_fmax at most 1 TPa (diamond's shear modulus is about half that)
-STRAIN_HALF_RANGE = (1e-9, 10.0)  # ε½: the range the fit searches
+STRAIN_HALF_RANGE = BY_NAME["friction_strain_half"].fit_range  # ε½: the range the fit searches
 
 
 @dataclass(frozen=True)
@@ -191,9 +191,8 @@ class Design:
             raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {self.mode!r}", BAD_CHOICE)
         if self.shape is not None and self.shape not in SHAPES:
             raise DesignError("shape", f"must be one of {', '.join(SHAPES)}, got {self.shape!r}", BAD_CHOICE)
-        if self.mode == "conical" and self.shape == "long":
-            raise DesignError("shape", "conical: no closed form holds for bushings of real length; use 'finite'",
-                              BAD_CHOICE)
+        if self.shape == "long" and no_long_form(self.mode):
+            raise DesignError("shape", no_long_form(self.mode), BAD_CHOICE)
         if not isinstance(self.geometry, Geometry):
             raise DesignError("geometry", "must be a Geometry", BAD_TYPE)
         if not isinstance(self.material, Material):
@@ -232,7 +231,7 @@ class Design:
         DesignError
             If ``mode`` is unknown.
         """
-        shape = None if (mode == "conical" and self.shape == "long") else self.shape
+        shape = None if (self.shape == "long" and no_long_form(mode)) else self.shape
         if (mode, shape) == (self.mode, self.shape):
             return self
         return self.replace(mode=mode, shape=shape, effects=self.portable_effects)

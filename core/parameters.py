@@ -156,6 +156,7 @@ class Mode:
     mass: str  # the unit of an apparent mass in this mode: kg or kg·m²
     default_shape: str  # the shape factor used unless a design names one (SHAPES)
     on_axis: bool  # along or about the bushing's axis (one direction); else across it (two alike)
+    long_form: bool = True  # a closed form of a long bushing exists (the shape "long" is allowed)
 
     @property
     def rotation(self) -> bool:
@@ -186,7 +187,7 @@ MODE_TABLE: tuple[Mode, ...] = (
     Mode("radial", "translation", "the sleeves moved apart across the axis", "Displacement",
          default_shape="finite", on_axis=False, **_TRANSLATION),
     Mode("conical", "rotation", "the sleeves tilted about a diameter", "Tilt angle", default_shape="finite",
-         on_axis=False, **_ROTATION),
+         on_axis=False, long_form=False, **_ROTATION),
 )
 MODE = {m.name: m for m in MODE_TABLE}
 MODES = tuple(MODE)
@@ -205,3 +206,9 @@ def mode(name: str) -> Mode:
     except (KeyError, TypeError):
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {name!r}") from None
 
+
+def no_long_form(mode_name: str) -> str | None:
+    """Why ``mode_name`` has no shape ``long`` (its rule's words), or None where it has one."""
+    if MODE[mode_name].long_form:
+        return None
+    return f"{mode_name}: no closed form holds for bushings of real length; use shape 'finite'"

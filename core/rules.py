@@ -83,6 +83,7 @@ CODES = (NOT_A_NUMBER, NOT_FINITE, OVERFLOW, NOT_POSITIVE, NEGATIVE, OUT_OF_RANG
 # a number written as text (a CSV cell, a command-line number): plain ASCII decimal notation; no
 # 1_000, no non-ASCII digits, no hex, no nan or inf (all of which Python's float() forgives)
 DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
+WHOLE = re.compile(r"[+-]?\d+", re.ASCII)  # a whole number's text: ASCII digits, as DECIMAL's
 _NOT_FINITE_WORDS = ("nan", "inf", "infinity")
 
 

@@ -43,7 +43,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .parameters import TRANSLATIONS
+from .parameters import TRANSLATIONS, no_long_form
 from .parameters import mode as checked_mode
 
 if TYPE_CHECKING:  # the type only: core.design imports this module
@@ -74,7 +74,7 @@ def long_shape_factor(a: float, b: float, L: float, mode: str) -> float:
     if mode == "radial":
         s = a * a + b * b
         return 4.0 * math.pi * L * s / (s * math.log(b / a) - (b * b - a * a))
-    raise ValueError("conical: no closed form holds for bushings of real length; use shape 'finite'")
+    raise ValueError(no_long_form(mode))
 
 
 def conical_reference(a: float, b: float, L: float) -> float:

@@ -104,3 +104,28 @@ def test_the_mode_and_amplitude_help_name_every_documented_mode():
     for mode in modes:
         assert mode in state.param.mode.doc.lower()
         assert mode in state.param.amplitude.doc  # the drive's unit in every mode (mm or rad)
+
+
+@pytest.mark.parametrize(("code", "words"), [("outer_not_larger", "Must be larger than the inner radius a."),
+                                              ("not_positive", "Must be positive."),
+                                              ("order_range", "Must lie in (0, 1].")])
+def test_the_panel_words_a_design_rule_by_its_code_not_by_its_english(code, words):
+    from app.fields import _plain
+    from core.rules import DesignError
+
+    # the core may reword a rule at any time: the panel still says its own words for the code
+    assert _plain(DesignError("geometry.outer_radius", "reworded by the core", code)) == words
+    # and English that merely contains a phrase of another rule is not mistaken for it
+    other = DesignError("material.shear_modulus", "must be positive and at most 1e12 Pa (b > a, (0, 1])", "out_of_range")
+    assert _plain(other) == "Must be positive and at most 1e12 Pa (b > a, (0, 1])"
+
+
+def test_each_field_shows_the_panel_words_of_the_core_s_rule():
+    # end to end through the state: the core's refusals as the panel words them
+    state = ExplorerState()
+    state.param.update(inner_radius_mm=40.0)  # b = 35 mm
+    assert state.errors == {"outer_radius_mm": "Must be larger than the inner radius a."}
+    state.param.update(inner_radius_mm=20.0, shear_modulus_mpa=-1.0)
+    assert state.errors == {"shear_modulus_mpa": "Must be positive."}
+    state.param.update(shear_modulus_mpa=2.42, fractional_order=1.5)
+    assert state.errors == {"fractional_order": "Must lie in (0, 1]."}

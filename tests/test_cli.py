@@ -129,6 +129,11 @@ BAD = [
     (["loop", "{axial}", "--freq", 1, "--amp", 0], "--amp"),
     (["loop", "{axial}", "--freq", 1, "--amp", 1e-3, "--points", 2], "--points"),
     (["loop", "{inertia}", "--freq", 1, "--amp", 1e-3], "effects.inertia"),
+    # every number on the command line is plain ASCII, as in the data files: other digits refused
+    (["stiffness", "{axial}", "--freq", 1, 100, "١٠", "--amp", 1e-4], "--freq N must be a whole number"),
+    (["loop", "{axial}", "--freq", 1, "--amp", 1e-3, "--points", "６４"], "--points must be a whole number"),
+    (["fit", "{measured}", "--design", "{axial}", "--fit-on", "amplitude=nan"], "amplitudes are numbers"),
+    (["fit", "{measured}", "--design", "{axial}", "--fit-on", "amplitude=1_0"], "amplitudes are numbers"),
     (["teleport"], "invalid choice"),
     ([], "required"),
 ]
@@ -139,7 +144,9 @@ def test_bad_input_is_one_line_and_status_2(argv, needle, designs, capsys, tmp_p
     bad = _bad_design(tmp_path, lambda d: d["geometry"].__setitem__("outer_radius", 0.01))
     inertia = tmp_path / "inertia.json"
     write_design(PAPER_B.replace(effects={"inertia": {"mass": 1.0}}), inertia)
-    argv = [str(a).format(axial=designs["axial"], bad=bad, inertia=inertia) for a in argv]
+    measured = tmp_path / "measured.csv"
+    measured.write_text("frequency_hz,amplitude,magnitude,loss_factor\n10,1e-4,4e6,0.14\n20,1e-4,4.2e6,0.15\n")
+    argv = [str(a).format(axial=designs["axial"], bad=bad, inertia=inertia, measured=measured) for a in argv]
     status, out, err = run(argv, capsys)
     assert status == 2
     assert out == ""

@@ -156,7 +156,7 @@ def test_each_material_parameter_moves_its_own_branch_of_the_modulus_only():
 
 # values by mode or by parameter that are no list of them: the finite-element model's symmetry
 # conditions of each mode, and the design search's default limits of each size
-KEPT = {("core/shape.py", "_HELD"), ("core/whatif/target.py", "DEFAULT_LIMITS")}
+KEPT = {("core/shape.py", "_HELD"), ("core/io/targets.py", "DEFAULT_LIMITS")}
 
 
 def _typed_out(node: ast.AST) -> bool:

@@ -38,6 +38,7 @@ from ..loops import loop_force
 from ..parameters import BRANCH_PARAMETERS, MATERIAL, Parameter
 from ..registry import parameter, parameter_unit, parameter_values, with_values
 from ..residuals import gap, gaps_by_mode, relative_residual
+from ..rules import decimal
 from ..sampling import latin_hypercube
 from ..shape import OutsideTable
 from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS, linearised, minimise, profile
@@ -397,7 +398,7 @@ def selection(data: MeasuredStiffness, design_mode: str, spec: str) -> np.ndarra
             chosen &= np.isin(modes.astype(str), values)
         else:
             try:
-                amps = [float(v) for v in values]
+                amps = [decimal(v) for v in values]
             except ValueError:
                 raise ValueError(f"--fit-on: {item!r}: amplitudes are numbers in m or rad") from None
             chosen &= np.any([np.isclose(data.amplitude, a, rtol=1e-6, atol=0) for a in amps], axis=0)

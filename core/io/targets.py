@@ -7,7 +7,6 @@ its code, :mod:`core.rules`).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -169,8 +168,8 @@ def problem_from_dict(data: Any) -> Problem:
                           BAD_CHOICE)
     free = {}
     for name, (low, high) in _ranges("free_material", data.get("free_material", {}), MATERIAL).items():
-        p_lo, p_hi = parameter(name).bounds  # within the fitting range (α also ≤ 1)
-        low, high = max(low or p_lo, p_lo, 1e-30), min(high or p_hi, p_hi, 1.0 if name == "fractional_order" else math.inf)
+        p_lo, p_hi = parameter(name).bounds  # within the fitting range (α's is (0, 1])
+        low, high = max(low or p_lo, p_lo, 1e-30), min(high or p_hi, p_hi)
         if not low < high:
             raise TargetError(f"free_material.{name}", "an empty range", OUT_OF_RANGE)
         free[name] = (low, high)
