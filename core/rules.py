@@ -19,16 +19,17 @@ code                 the input
 ``negative``         is negative where zero or more is needed (an effect's parameter, a tolerance)
 ``out_of_range``     lies outside a stated range (sizes 1 µm – 1 km, moduli at most 1 TPa, ε½,
                      measured frequencies and |K|, a phase, counts, percentiles, a tolerance
-                     that takes a part outside what the model takes, a drive beyond the strain
-                     the model takes)
+                     that takes a part, or a band's sample, outside what the model takes, a
+                     drive beyond the strain the model takes)
 ``outer_not_larger`` makes the outer radius b no larger than the inner radius a (b ≤ a)
 ``order_range``      is a fractional order α outside (0, 1]
 ``unknown_key``      is a key, column, parameter or effect the format does not know
 ``missing_key``      leaves out a required key, column or cell
 ``duplicate_key``    gives a key twice (in JSON, or in two forms: relative and absolute)
-``bad_choice``       is not one of the words allowed (a mode, shape, distribution), or a
-                     combination the rules refuse (conical with the long shape, one mode as a
-                     ratio, a rubber effect tied to a mode)
+``bad_choice``       is not one of the words allowed (a mode, shape, distribution, the mode
+                     after an effect's @), or a combination the rules refuse (conical with the
+                     long shape, one mode as a ratio, a rubber effect tied to a mode, a branch
+                     of the material model given as an effect)
 ``bad_type``         is the wrong kind of value: an object, list, text or true/false expected
 ``conflict``         says two things that exclude each other (two forms of the stiffness, min
                      above max, mode and ratio together)
@@ -43,7 +44,6 @@ code                 the input
 ``unreadable``       is a file that cannot be read (missing, a folder, no permission)
 ``invalid``          breaks a rule not listed (an error made outside the core's readers)
 ==================== ==========================================================================
-"""
 """
 
 from __future__ import annotations
