@@ -1,9 +1,9 @@
 """The explorer's file uploads: Panel's FileDropper (FilePond in the browser).
 
-A file larger than the readers accept (:data:`core.data.MAX_BYTES`) is refused by the browser
-before a byte is sent, with the limit in its message ("File is too large. Maximum file size is
-20 MB"); smaller files travel in chunks well under the websocket's message limit, so no upload
-can close the session.
+A file larger than the readers accept (:data:`core.io.measured.MAX_BYTES`) is refused by the
+browser before a byte is sent, with the limit in its message ("File is too large. Maximum file
+size is 20 MB"); smaller files travel in chunks well under the websocket's message limit, so no
+upload can close the session.
 """
 
 from __future__ import annotations

@@ -25,7 +25,7 @@ from scipy import special
 from .material import REFERENCE_FREQUENCY_HZ
 from .material import branch_moduli as material_branch_moduli
 from .parameters import BRANCH_PARAMETERS, BY_NAME, MODE, MODES, TRANSLATIONS, Parameter
-from .rules import DesignError
+from .rules import BAD_CHOICE, BAD_TYPE, MISSING_KEY, NEGATIVE, UNKNOWN_KEY, DesignError
 from .rules import number as _number
 
 if TYPE_CHECKING:
@@ -193,38 +193,40 @@ def validate_effects(effects: Any) -> dict[str, dict[str, float]]:
     tied to another mode as ``id@mode``; an effect of the rubber may not.
     """
     if not isinstance(effects, Mapping):
-        raise DesignError("effects", "must be an object mapping effect ids to their parameters")
+        raise DesignError("effects", "must be an object mapping effect ids to their parameters",
+                          BAD_TYPE)
     out: dict[str, dict[str, float]] = {}
     for eid, params in effects.items():
         key = f"effects.{eid}"
         base, mode = split_id(str(eid))
         if base not in EFFECTS:
-            raise DesignError(key, f"unknown effect (known: {', '.join(EFFECTS)})")
+            raise DesignError(key, f"unknown effect (known: {', '.join(EFFECTS)})", UNKNOWN_KEY)
         effect = EFFECTS[base]
         if mode is not None and not effect.rig:
             rigs = ", ".join(e.id for e in EFFECTS.values() if e.rig)
             raise DesignError(key, f"only an effect of the test rig ({rigs}) can be tied to a mode; "
-                                   f"{base} is the rubber's and acts in every mode")
+                                   f"{base} is the rubber's and acts in every mode", BAD_CHOICE)
         if mode is not None and mode not in MODES:
-            raise DesignError(key, f"the mode after @ must be one of {', '.join(MODES)}, got {mode!r}")
+            raise DesignError(key, f"the mode after @ must be one of {', '.join(MODES)}, got {mode!r}",
+                              BAD_CHOICE)
         if effect.branch:
-            raise DesignError(
-                key, "is a branch of the material model; its parameters belong in material"
-            )
+            raise DesignError(key, "is a branch of the material model; its parameters belong in "
+                                   "material", BAD_CHOICE)
         if not isinstance(params, Mapping):
-            raise DesignError(key, "must be an object of parameter values")
+            raise DesignError(key, "must be an object of parameter values", BAD_TYPE)
         names = [p.name for p in effect.parameters]
         for name in params:
             if name not in names:
                 allowed = ", ".join(names) or "none"
-                raise DesignError(f"{key}.{name}", f"unknown parameter (allowed: {allowed})")
+                raise DesignError(f"{key}.{name}", f"unknown parameter (allowed: {allowed})",
+                                  UNKNOWN_KEY)
         values = {}
         for name in names:
             if name not in params:
-                raise DesignError(f"{key}.{name}", "missing (required)")
+                raise DesignError(f"{key}.{name}", "missing (required)", MISSING_KEY)
             v = _number(f"{key}.{name}", params[name])
             if v < 0:
-                raise DesignError(f"{key}.{name}", f"must be ≥ 0, got {v!r}")
+                raise DesignError(f"{key}.{name}", f"must be ≥ 0, got {v!r}", NEGATIVE)
             values[name] = v
         out[eid] = values
     return out

@@ -19,16 +19,17 @@ code                 the input
 ``negative``         is negative where zero or more is needed (an effect's parameter, a tolerance)
 ``out_of_range``     lies outside a stated range (sizes 1 µm – 1 km, moduli at most 1 TPa, ε½,
                      measured frequencies and |K|, a phase, counts, percentiles, a tolerance
-                     that takes a part outside what the model takes, a drive beyond the strain
-                     the model takes)
+                     that takes a part, or a band's sample, outside what the model takes, a
+                     drive beyond the strain the model takes)
 ``outer_not_larger`` makes the outer radius b no larger than the inner radius a (b ≤ a)
 ``order_range``      is a fractional order α outside (0, 1]
 ``unknown_key``      is a key, column, parameter or effect the format does not know
 ``missing_key``      leaves out a required key, column or cell
 ``duplicate_key``    gives a key twice (in JSON, or in two forms: relative and absolute)
-``bad_choice``       is not one of the words allowed (a mode, shape, distribution), or a
-                     combination the rules refuse (conical with the long shape, one mode as a
-                     ratio, a rubber effect tied to a mode)
+``bad_choice``       is not one of the words allowed (a mode, shape, distribution, the mode
+                     after an effect's @), or a combination the rules refuse (conical with the
+                     long shape, one mode as a ratio, a rubber effect tied to a mode, a branch
+                     of the material model given as an effect)
 ``bad_type``         is the wrong kind of value: an object, list, text or true/false expected
 ``conflict``         says two things that exclude each other (two forms of the stiffness, min
                      above max, mode and ratio together)
@@ -88,9 +89,35 @@ _NOT_FINITE_WORDS = ("nan", "inf", "infinity")
 
 
 class RuleError(ValueError):
-    """An input that breaks a rule: ``key`` (where; "" for the whole input), ``rule`` (what, in
-    plain words) and ``code`` (which rule, one of :data:`CODES`). The message is ``key: rule``,
-    or ``rule`` alone without a key; given one argument, that is the whole message (no key)."""
+    """An input that breaks a rule: where, what in plain words, and which rule.
+
+    The message is ``key: rule``, or ``rule`` alone without a key; given one argument, that is
+    the whole message (no key).
+
+    Parameters
+    ----------
+    key : str
+        Where the input breaks the rule (``geometry.outer_radius``, ``line 6``); "" for the
+        whole input. Given alone, it is the rule and the key is "".
+    rule : str or None, optional
+        What is wrong, in plain words.
+    code : str, optional
+        Which rule, one of :data:`CODES` (``invalid`` by default).
+
+    Attributes
+    ----------
+    key : str
+        Where, as given ("" for the whole input).
+    rule : str
+        What, in plain words.
+    code : str
+        Which rule, one of :data:`CODES`, for a program to word its own message by.
+
+    Raises
+    ------
+    ValueError
+        If ``code`` is not one of :data:`CODES`.
+    """
 
     def __init__(self, key: str, rule: str | None = None, code: str = INVALID):
         if rule is None:
@@ -102,7 +129,31 @@ class RuleError(ValueError):
 
 
 class DesignError(RuleError):
-    """A design value or design file that breaks a rule; ``key`` names the offending field."""
+    """A design value or a design file that breaks a rule, naming the offending key.
+
+    Raised by :class:`core.design.Design` and its parts for a value off its rule, and by the
+    readers of :mod:`core.io.design_file` for a file that is no design file. The message is
+    ``key: rule`` (``rule`` alone for the whole file), as of :class:`RuleError`.
+
+    Parameters
+    ----------
+    key : str
+        The design file's key that breaks the rule, dotted (``geometry.outer_radius``,
+        ``effects.inertia.mass``); "" for the whole file (too large, not UTF-8, not JSON).
+    rule : str or None, optional
+        What is wrong, in plain words (a value's unit is the design file's, SI).
+    code : str, optional
+        Which rule, one of :data:`CODES` (``outer_not_larger``, ``order_range``, ``bad_json``…).
+
+    Attributes
+    ----------
+    key : str
+        The offending key, dotted; "" for the whole file.
+    rule : str
+        What is wrong, in plain words.
+    code : str
+        Which rule, one of :data:`CODES`.
+    """
 
 
 # ---- numbers ----------------------------------------------------------------------------------

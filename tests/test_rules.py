@@ -10,12 +10,14 @@ import pytest
 
 from cli.main import main
 from core import PAPER_B, write_design
+from core.bushing import MAX_STRAIN
 from core.io.design_file import loads_design, read_design
 from core.io.measured import parse_loop, parse_stiffness, read_stiffness
 from core.io.targets import loads_problem
 from core.io.tolerances import loads_tolerances
 from core.rules import CODES, RuleError
 from core.sampling import latin_hypercube
+from core.whatif.tolerance import MAX_EVALUATIONS, Tolerances, band
 
 
 def _design(**section) -> str:
@@ -69,6 +71,47 @@ def test_a_design_file_names_the_rule_of_the_file(tmp_path):
     (tmp_path / "bad.json").write_text(_design(geometry={"outer_radius": 0.01}))
     err = _refused(read_design, tmp_path / "bad.json")
     assert (err.key, err.code) == ("geometry.outer_radius", "outer_not_larger") and "(in bad.json)" in err.rule
+
+
+def _effects(effects) -> str:
+    return json.dumps({**PAPER_B.to_dict(), "effects": effects})
+
+
+@pytest.mark.parametrize("effects, key, code", [
+    ("inertia", "effects", "bad_type"),
+    ({"colour": {}}, "effects.colour", "unknown_key"),
+    ({"viscous@torsion": {"viscosity": 1.0}}, "effects.viscous@torsion", "bad_choice"),  # the rubber's
+    ({"inertia@shear": {"mass": 0.5}}, "effects.inertia@shear", "bad_choice"),
+    ({"friction": {"friction_stress_max": 1e4, "friction_strain_half": 1e-3}}, "effects.friction",
+     "bad_choice"),  # a branch: its parameters belong in material
+    ({"inertia": 0.5}, "effects.inertia", "bad_type"),
+    ({"inertia": {"mass": 0.5, "colour": 1}}, "effects.inertia.colour", "unknown_key"),
+    ({"inertia": {}}, "effects.inertia.mass", "missing_key"),
+    ({"inertia": {"mass": -0.5}}, "effects.inertia.mass", "negative"),
+])
+def test_an_effect_refusal_names_its_key_and_its_rule_code(effects, key, code):
+    err = _refused(loads_design, _effects(effects))
+    assert (err.key, err.code) == (key, code), str(err)
+
+
+def test_a_band_too_large_is_refused_as_too_large():
+    """5000 samples × 4001 points: past the evaluations a band may take, refused before any."""
+    tolerances = Tolerances({"shear_modulus": 0.1}, samples=5000, seed=1)
+    points = MAX_EVALUATIONS // 5000 + 1
+    err = _refused(lambda f: band(PAPER_B, f, 1e-4, tolerances), np.linspace(1.0, 100.0, points))
+    assert (err.key, err.code) == ("", "too_large"), str(err)
+
+
+@pytest.mark.parametrize("effects", [{}, {"inertia": {"mass": 0.5}}])  # all samples at once; one by one
+def test_a_band_sample_beyond_the_models_strain_is_refused_as_out_of_range(effects):
+    """At 99 % of the largest drive the nominal design takes, a sample whose outer radius is
+    10 % smaller strains the rubber more (axial c = 1 / √(2 (b² − a²) ln(b/a)), eq 15): beyond
+    what the model takes."""
+    design = PAPER_B.replace(effects=effects)
+    tolerances = Tolerances({"outer_radius": 0.1}, samples=50, seed=1)
+    err = _refused(lambda x: band(design, 10.0, x, tolerances), 0.99 * design.drive(MAX_STRAIN))
+    assert (err.key, err.code) == ("", "out_of_range"), str(err)
+    assert "within these tolerances the bushing leaves what the model computes" in err.rule
 
 
 HEAD = "frequency_hz,amplitude,magnitude,loss_factor\n"

@@ -70,9 +70,29 @@ def design_from_dict(data: Any) -> Design:
 
 
 def loads_design(text: str) -> Design:
-    """A design from design-file text: strict JSON (no key twice, at most
-    :data:`MAX_DESIGN_BYTES` characters), then :func:`design_from_dict`'s rules (which refuse
-    NaN and infinities by their key)."""
+    """Read a design from the text of a design file (docs/files.md).
+
+    The text is strict JSON (no key given twice, at most :data:`MAX_DESIGN_BYTES` characters,
+    not nested too deeply), then :func:`design_from_dict`'s rules, which refuse NaN and
+    infinities by their key. A fitted file's ``fit`` report is read past (see
+    :func:`loads_design_file`).
+
+    Parameters
+    ----------
+    text : str
+        The design file's JSON text; its values in SI units (m, Pa, Pa·s^α).
+
+    Returns
+    -------
+    Design
+        The design the text describes.
+
+    Raises
+    ------
+    DesignError
+        If the text is too long, no valid JSON, gives a key twice, or a key or value breaks a
+        rule of the design file; the error names the key and carries the rule's code.
+    """
     return loads_design_file(text)[0]
 
 
@@ -84,6 +104,29 @@ def loads_design_file(text: str) -> tuple[Design, dict | None]:
 
 
 def read_design(path: str | Path) -> Design:
+    """Read a design from a design file (docs/files.md).
+
+    The file is read once, at most :data:`MAX_DESIGN_BYTES` bytes of UTF-8 (a byte-order mark
+    is accepted), then held to :func:`loads_design`'s rules. A fitted file's ``fit`` report is
+    read past (see :func:`read_design_file`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The design file; its values in SI units (m, Pa, Pa·s^α).
+
+    Returns
+    -------
+    Design
+        The design the file describes.
+
+    Raises
+    ------
+    DesignError
+        If the file cannot be read (``unreadable``), is too large (``too_large``) or not UTF-8
+        (``not_utf8``), or its content breaks a rule of :func:`loads_design`; a refusal of the
+        content names the key, and the file's name in the rule.
+    """
     return read_design_file(path)[0]
 
 
@@ -99,8 +142,39 @@ def read_design_file(path: str | Path) -> tuple[Design, dict | None]:
 
 
 def dumps_design(design: Design) -> str:
+    """Write a design as the text of a design file (docs/files.md).
+
+    :func:`loads_design` reads the text back to an equal design.
+
+    Parameters
+    ----------
+    design : Design
+        The design to write.
+
+    Returns
+    -------
+    str
+        JSON of :meth:`Design.to_dict`, indented by two spaces and ending in a newline; the
+        values in SI units (m, Pa, Pa·s^α).
+    """
     return json.dumps(design.to_dict(), indent=2) + "\n"
 
 
 def write_design(design: Design, path: str | Path) -> None:
+    """Write a design to a design file (docs/files.md), UTF-8, as :func:`dumps_design` words it.
+
+    :func:`read_design` reads the file back to an equal design; an existing file is replaced.
+
+    Parameters
+    ----------
+    design : Design
+        The design to write.
+    path : str or Path
+        The file to write.
+
+    Raises
+    ------
+    OSError
+        If the file cannot be written.
+    """
     Path(path).write_text(dumps_design(design), encoding="utf-8")

@@ -52,6 +52,7 @@ from ..rules import (
     NOT_FINITE,
     OUT_OF_RANGE,
     OUTER_NOT_LARGER,
+    TOO_LARGE,
     UNKNOWN_KEY,
     RuleError,
     is_number,
@@ -258,8 +259,9 @@ def band(design: Design, frequency_hz, amplitude, tolerances: Tolerances, **kwar
     shape = np.broadcast_shapes(f.shape, x.shape)
     points = int(np.prod(shape))
     if tolerances.samples * points > MAX_EVALUATIONS:
-        raise ToleranceError(f"{tolerances.samples} samples × {points} points is more than {MAX_EVALUATIONS:.3g} "
-                             "evaluations: use fewer samples or a coarser grid")
+        raise ToleranceError("", f"{tolerances.samples} samples × {points} points is more than "
+                             f"{MAX_EVALUATIONS:.3g} evaluations: use fewer samples or a coarser grid",
+                             TOO_LARGE)
     nominal = np.broadcast_to(stiffness_points(design, f, x, **kwargs), shape)
     k = sample_stiffness(design, tolerances.draws(design), f, x, **kwargs)
     magnitude, eta = np.abs(k), loss_factor(k)
@@ -274,7 +276,8 @@ def band(design: Design, frequency_hz, amplitude, tolerances: Tolerances, **kwar
 def _refused(exc: Exception, sample: int | None = None) -> ToleranceError:
     """The band's refusal of a sample (numbered from 1) or of some sample the model refuses."""
     where = "" if sample is None else f"sample {sample + 1}: "
-    return ToleranceError(f"{where}within these tolerances the bushing leaves what the model computes: {exc}")
+    return ToleranceError("", f"{where}within these tolerances the bushing leaves what the model computes: "
+                          f"{exc}", OUT_OF_RANGE)
 
 
 def sample_stiffness(design: Design, draws: list[dict[str, float]], frequency_hz, amplitude,
