@@ -14,8 +14,8 @@ import param
 
 from core import PAPER_B, Design, DesignError, Geometry, Material
 from core.bushing import factors
-from core.design import SIZE_RANGE, as_dict
 from core.parameters import BY_NAME, GEOMETRY, MATERIAL, PARAMETERS, DesignParameter
+from core.parts import SIZE_RANGE, as_dict
 from core.rules import NOT_POSITIVE, ORDER_RANGE, OUTER_NOT_LARGER
 
 # field name → its design parameter, in the table's order (geometry, then material)

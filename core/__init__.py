@@ -5,10 +5,12 @@ frequency and amplitude, after García Tárrago (KTH, 2006). See docs/model.md f
 """
 
 from .bushing import StiffnessResult, shape_factor, stiffness, stiffness_points, strain_factor
-from .design import PAPER_B, TABLE_1, Design, DesignError, Geometry, Material
+from .design import PAPER_B, TABLE_1, Design
 from .io.design_file import dumps_design, loads_design, read_design, write_design
 from .loops import HistoryResult, LoopResult, force_history, loop
 from .material import ConvergenceError, equivalent_modulus, equivalent_modulus_time_domain
+from .parts import Geometry, Material
+from .rules import DesignError
 
 __all__ = [
     "PAPER_B",

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from scipy import special
@@ -25,11 +25,9 @@ from scipy import special
 from .material import REFERENCE_FREQUENCY_HZ
 from .material import branch_moduli as material_branch_moduli
 from .parameters import BRANCH_PARAMETERS, BY_NAME, MODE, MODES, TRANSLATIONS, Parameter
+from .parts import Material
 from .rules import BAD_CHOICE, BAD_TYPE, MISSING_KEY, NEGATIVE, UNKNOWN_KEY, DesignError
 from .rules import number as _number
-
-if TYPE_CHECKING:
-    from .design import Material
 
 
 def _branch(branch: str) -> tuple[Parameter, ...]:

@@ -16,13 +16,11 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.signal import oaconvolve
 
-if TYPE_CHECKING:
-    from .design import Material
+from .parts import Material
 
 REFERENCE_FREQUENCY_HZ = 10.0  # rate_amplitude_coupling: µ_f · (f / 10 Hz)^γ
 

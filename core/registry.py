@@ -9,9 +9,10 @@ whether it is fitted as its logarithm.
 
 from __future__ import annotations
 
-from .design import Design, as_dict
+from .design import Design
 from .effects import EFFECTS, split_id
 from .parameters import BY_NAME, MATERIAL, Parameter
+from .parts import as_dict
 
 
 def parameter(name: str) -> Parameter:

@@ -39,15 +39,12 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .parameters import TRANSLATIONS, no_long_form
 from .parameters import mode as checked_mode
-
-if TYPE_CHECKING:  # the type only: core.design imports this module
-    from .design import Geometry
+from .parts import Geometry
 
 TABLE_PATH = Path(__file__).with_name("shape_table.json")
 BULK_RATIO = 5000.0  # K/µ of the FE model: rubber's is 1 000–5 000

@@ -25,8 +25,8 @@ from itertools import pairwise
 
 import numpy as np
 
-from .design import Geometry
 from .material import ConvergenceError
+from .parts import Geometry
 from .shape import shape_factor, strain_factor
 
 

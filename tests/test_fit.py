@@ -7,9 +7,9 @@ from numpy.testing import assert_allclose
 
 from core import PAPER_B, TABLE_1, stiffness, stiffness_points
 from core.data import MeasuredLoop
-from core.design import as_dict
 from core.identify.fit import fit_global, fit_two_step
 from core.parameters import MATERIAL as PARAMETERS
+from core.parts import as_dict
 from core.synthetic import synthetic_loop as make_loop
 from core.synthetic import synthetic_stiffness
 

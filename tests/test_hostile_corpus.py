@@ -375,8 +375,8 @@ def same(output: str, got: str, want: str, rtol: float) -> None:
 def test_the_corpus_names_only_real_keys():
     """An effect, parameter or key misspelt in the corpus tests nothing (it is refused as unknown
     whatever the value): every name it uses is one the core knows."""
-    from core.design import Geometry, Material
     from core.effects import EFFECTS
+    from core.parts import Geometry, Material
 
     for eid, parameter in EFFECT_CASES:
         assert eid in EFFECTS and parameter in [p.name for p in EFFECTS[eid].parameters], (eid, parameter)

@@ -1,5 +1,6 @@
 """The core's imports: no circle among its modules (imports inside functions count: one there
-only hides a circle; those under ``if TYPE_CHECKING:`` are for annotations and do not run), no
+only hides a circle; so do those under ``if TYPE_CHECKING:``, which hide one from the
+interpreter but not from a reader: the types live below the modules that use them), no
 command-line parser or user interface library, and every module importable on its own in a
 fresh interpreter, before any other (``core/__init__.py``, which imports most of them, skipped)."""
 
@@ -23,18 +24,9 @@ def _module(path: Path) -> str:
 MODULES = sorted(_module(p) for p in CORE.rglob("*.py"))
 
 
-def _type_checking(node: ast.AST) -> bool:
-    test = node.test if isinstance(node, ast.If) else None
-    return isinstance(test, ast.Name) and test.id == "TYPE_CHECKING" or \
-        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING"
-
-
 def _imports(tree: ast.AST):
-    """Every import statement of a module, at any depth, except under ``if TYPE_CHECKING:``."""
+    """Every import statement of a module, at any depth."""
     for node in ast.iter_child_nodes(tree):
-        if isinstance(node, ast.If) and _type_checking(node):
-            yield from (i for child in node.orelse for i in _imports(ast.Module([child], [])))
-            continue
         if isinstance(node, (ast.Import, ast.ImportFrom)):
             yield node
         yield from _imports(node)

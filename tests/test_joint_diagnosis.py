@@ -7,12 +7,12 @@ import pytest
 from core import PAPER_B
 from core.bushing import stiffness_points
 from core.data import MeasuredStiffness
-from core.design import DesignError
 from core.identify.diagnose import diagnose, summary
 from core.identify.diagnose.statistics import runs
 from core.identify.fit import fit_global, model_stiffness
 from core.io.design_file import design_from_dict
 from core.io.measured import combined
+from core.rules import DesignError
 from core.synthetic import synthetic_stiffness
 
 NOISE = 0.005

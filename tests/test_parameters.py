@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from core.design import PAPER_B, TABLE_1, Geometry, Material, as_dict
+from core.design import PAPER_B, TABLE_1
 from core.effects import branch_moduli
 from core.parameters import (
     BRANCH_PARAMETERS,
@@ -22,6 +22,7 @@ from core.parameters import (
     NAMES,
     PARAMETERS,
 )
+from core.parts import Geometry, Material, as_dict
 from core.registry import parameter, parameter_unit
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -11,7 +11,7 @@ import pytest
 
 from core import PAPER_B, stiffness
 from core.bushing import factors, shape_factor
-from core.design import DesignError
+from core.rules import DesignError
 from core.shape import (
     OutsideTable,
     converged_shape_factor,

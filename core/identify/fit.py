@@ -33,9 +33,10 @@ import numpy as np
 
 from ..bushing import check_measured_amplitude, stiffness_points
 from ..data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
-from ..design import Design, as_dict
+from ..design import Design
 from ..loops import loop_force
 from ..parameters import BRANCH_PARAMETERS, MATERIAL, Parameter
+from ..parts import as_dict
 from ..registry import parameter, parameter_unit, parameter_values, with_values
 from ..residuals import gap, gaps_by_mode, relative_residual
 from ..rules import decimal

@@ -11,8 +11,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from ..design import Design, Geometry, Material
+from ..design import Design
 from ..parameters import GEOMETRY, MATERIAL, MODES
+from ..parts import Geometry, Material
 from ..rules import (
     BAD_CHOICE,
     BAD_TYPE,

@@ -12,8 +12,9 @@ from pathlib import Path
 from typing import Any
 
 from ..bushing import stiffness_points
-from ..design import SIZE_RANGE, Design, DesignError
+from ..design import Design
 from ..parameters import GEOMETRY, MATERIAL, MODE, MODES
+from ..parts import SIZE_RANGE
 from ..registry import parameter
 from ..rules import (
     BAD_CHOICE,
@@ -23,6 +24,7 @@ from ..rules import (
     NOT_POSITIVE,
     OUT_OF_RANGE,
     UNKNOWN_KEY,
+    DesignError,
     RuleError,
     input_file_words,
     positive,

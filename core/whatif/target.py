@@ -30,10 +30,10 @@ import numpy as np
 from scipy.optimize import least_squares, minimize
 
 from ..bushing import MAX_STRAIN, stiffness_points
-from ..design import Design, DesignError
+from ..design import Design
 from ..parameters import GEOMETRY, MODE
 from ..response import loss_factor
-from ..rules import RuleError
+from ..rules import DesignError, RuleError
 from ..sampling import latin_hypercube
 
 SEARCHED = tuple("thickness" if n == "outer_radius" else n for n in GEOMETRY)  # a, t = b − a, L

@@ -37,10 +37,11 @@ from ..bushing import (
     stiffness_points,
     strain_factor,
 )
-from ..design import Design, DesignError, Geometry
+from ..design import Design
 from ..identify.fit import FitResult
 from ..material import equivalent_modulus
 from ..parameters import GEOMETRY, MATERIAL, NAMES
+from ..parts import Geometry
 from ..registry import parameter
 from ..response import loss_factor
 from ..rules import (
@@ -54,6 +55,7 @@ from ..rules import (
     OUTER_NOT_LARGER,
     TOO_LARGE,
     UNKNOWN_KEY,
+    DesignError,
     RuleError,
     is_number,
     whole_number,

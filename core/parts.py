@@ -1,0 +1,113 @@
+"""The bushing's parts as values: its geometry (the bonded radii and the length) and its
+compound (the five parameters of the material model), validated and immutable, in SI units.
+
+:class:`core.design.Design` puts them together with a mode; :mod:`core.material` computes with a
+:class:`Material`. A value that breaks a rule is refused with a :class:`core.rules.DesignError`
+naming the key (``geometry.outer_radius``) and the rule's code.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+from .parameters import BY_NAME
+from .rules import ORDER_RANGE, OUT_OF_RANGE, OUTER_NOT_LARGER, DesignError, number, positive
+
+SIZE_RANGE = (1e-6, 1e3)  # m: radii and lengths from a micrometre to a kilometre, no further
+MAX_MODULUS = 1e12  # Pa: µ, m and σ_fmax at most 1 TPa (diamond's shear modulus is about half that)
+STRAIN_HALF_RANGE = BY_NAME["friction_strain_half"].fit_range  # ε½: the range the fit searches
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Bonded radii and length of a cylindrical bushing, in metres.
+
+    Attributes
+    ----------
+    inner_radius : float
+        a, the inner (bonded) radius, in m.
+    outer_radius : float
+        b, the outer (bonded) radius, in m; b > a.
+    length : float
+        L, the bushing's length, in m.
+
+    Raises
+    ------
+    DesignError
+        If a value is no finite number in :data:`SIZE_RANGE` (m) or b ≤ a; it names the key.
+    """
+
+    inner_radius: float
+    outer_radius: float
+    length: float
+
+    def __post_init__(self):
+        for f in fields(self):
+            key = f"geometry.{f.name}"
+            value = positive(key, getattr(self, f.name))
+            if not SIZE_RANGE[0] <= value <= SIZE_RANGE[1]:
+                raise DesignError(key, f"must lie between {SIZE_RANGE[0]:g} and {SIZE_RANGE[1]:g} m, got {value!r}",
+                                  OUT_OF_RANGE)
+            object.__setattr__(self, f.name, value)
+        if self.outer_radius <= self.inner_radius:
+            raise DesignError(
+                "geometry.outer_radius",
+                f"must be larger than geometry.inner_radius (b > a), got b = {self.outer_radius!r}"
+                f" and a = {self.inner_radius!r}",
+                OUTER_NOT_LARGER,
+            )
+
+
+@dataclass(frozen=True)
+class Material:
+    """The five parameters of the elastic + fractional + friction model (eqs 1–7), SI units.
+
+    Attributes
+    ----------
+    shear_modulus : float
+        µ, the elastic branch's shear modulus (eq 1), in Pa.
+    fractional_coefficient : float
+        m, the fractional-derivative coefficient (eq 3), in Pa·s^α.
+    fractional_order : float
+        α, the fractional order, 0 < α ≤ 1, dimensionless.
+    friction_stress_max : float
+        σ_fmax, the largest friction stress (eq 6), in Pa.
+    friction_strain_half : float
+        ε½, the strain at which half of σ_fmax is built (eq 6), dimensionless.
+
+    Raises
+    ------
+    DesignError
+        If a value is no finite number, a modulus is not in (0, :data:`MAX_MODULUS`] (Pa), α is
+        not in (0, 1] or ε½ not in :data:`STRAIN_HALF_RANGE`; it names the key.
+    """
+
+    shear_modulus: float
+    fractional_coefficient: float
+    fractional_order: float
+    friction_stress_max: float
+    friction_strain_half: float
+
+    def __post_init__(self):
+        for f in fields(self):
+            key = f"material.{f.name}"
+            value = getattr(self, f.name)
+            if f.name == "fractional_order":
+                value = number(key, value)
+                if not 0.0 < value <= 1.0:
+                    raise DesignError(key, f"must lie in (0, 1], got {value!r}", ORDER_RANGE)
+            elif f.name == "friction_strain_half":
+                value = positive(key, value)
+                if not STRAIN_HALF_RANGE[0] <= value <= STRAIN_HALF_RANGE[1]:
+                    raise DesignError(key, f"must lie between {STRAIN_HALF_RANGE[0]:g} and {STRAIN_HALF_RANGE[1]:g}, "
+                                      f"got {value!r}", OUT_OF_RANGE)
+            else:
+                value = positive(key, value)
+                if value > MAX_MODULUS:
+                    raise DesignError(key, f"must be at most {MAX_MODULUS:g} Pa, got {value!r}", OUT_OF_RANGE)
+            object.__setattr__(self, f.name, value)
+
+
+def as_dict(value) -> dict[str, float]:
+    """A Geometry's or a Material's fields by name (SI)."""
+    return {f.name: getattr(value, f.name) for f in fields(value)}
