@@ -121,10 +121,9 @@ class DesignInputs(pn.viewable.Viewer):
     def __init__(self, state: ExplorerState, **params):
         super().__init__(**params)
         self.state = state
-        steps = {"fractional_order": 0.05, "friction_strain_half": 5e-4}
         self.widgets = {
             name: FloatInput.from_param(
-                state.param[name], description=state.param[name].doc, step=steps.get(name, 0.5),
+                state.param[name], description=state.param[name].doc, step=DESIGN_FIELDS[name].step,
                 sizing_mode="stretch_width", label=state.param[name].label,
             )
             for name in DESIGN_FIELDS

@@ -27,7 +27,9 @@ from .views import PlotView
 
 log = logging.getLogger("bushing.app")
 
-A, B, L, MU = (BY_NAME[n] for n in ("inner_radius", "outer_radius", "length", "shear_modulus"))
+A, B, L, MU = (BY_NAME[n] for n in (*GEOMETRY, "shear_modulus"))
+# the what-if's ratio target: radial over axial |K| (a pair chosen by meaning, not a list of modes)
+STIFFNESS_RATIO = ("radial", "axial")
 # a found design's columns: its geometry and µ (what a search changes), each to its digits
 FOUND_COLUMNS = {**{n: ".3f" for n in GEOMETRY}, L.name: ".2f", MU.name: ".4g"}
 
@@ -188,7 +190,7 @@ class WhatIfView(PlotView):
             targets.append({"mode": mode, "frequency_hz": f, "amplitude": x, "loss_factor": {"min": self.loss_factor_min}})
         if self.ratio_min:
             drive = x if mode in TRANSLATIONS else 1e-4  # a translation's drive: the operating one, or 0.1 mm
-            targets.append({"ratio": ["radial", "axial"], "frequency_hz": f, "amplitude": drive,
+            targets.append({"ratio": list(STIFFNESS_RATIO), "frequency_hz": f, "amplitude": drive,
                             "magnitude": {"min": self.ratio_min}})
         limits = {}
         if self.b_max_mm:

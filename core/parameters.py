@@ -78,6 +78,7 @@ class DesignParameter:
     fit_range: tuple[float, float] | None = None
     log: bool = True  # fitted as its logarithm (a scale) or as itself
     branch: str | None = None  # the material's: the branch of the model (eqs 1, 2, 6) it sizes or shapes
+    step: float = 0.5  # the explorer's step for its field, in the display unit
 
     @property
     def field(self) -> str:
@@ -121,13 +122,13 @@ PARAMETERS: tuple[DesignParameter, ...] = (
                     "fractional coefficient m", (1e-2, 1e11), branch="fractional"),
     DesignParameter("fractional_order", "material", "α", Unit("–", "–"), "alpha", "Fractional order α",
                     "Fractional order α in (0, 1]: how fast stiffness rises with frequency.",
-                    "fractional order α in (0, 1]", (1e-3, 1.0), log=False, branch="fractional"),
+                    "fractional order α in (0, 1]", (1e-3, 1.0), log=False, branch="fractional", step=0.05),
     DesignParameter("friction_stress_max", "material", "σ_fmax", Unit("Pa", "kPa", 1e3), "sigma",
                     "Friction stress σ_fmax", "Largest friction stress σ_fmax: size of the amplitude dependence.",
                     "largest friction stress σ_fmax", (1e-3, 1e9), branch="friction"),
     DesignParameter("friction_strain_half", "material", "ε½", Unit("–", "–"), "eps_half", "Friction strain ε½",
                     "Strain ε½ at which half of σ_fmax is built: where the softening happens.",
-                    "strain ε½ to build half of σ_fmax", (1e-9, 10.0), branch="friction"),
+                    "strain ε½ to build half of σ_fmax", (1e-9, 10.0), branch="friction", step=5e-4),
 )
 BY_NAME = {p.name: p for p in PARAMETERS}
 GEOMETRY = tuple(p.name for p in PARAMETERS if p.group == "geometry")

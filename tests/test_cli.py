@@ -215,3 +215,16 @@ def test_serve_refuses_a_busy_or_impossible_port(capsys):
     assert status == 2 and err.count("\n") == 1 and "cannot listen" in err
     status, _, err = run(["serve", "--port", 70000], capsys)
     assert status == 2 and "65535" in err
+
+
+def test_the_command_line_loads_the_browser_libraries_only_to_serve(designs, tmp_path):
+    # `bushing card` and every other command run without Panel, Bokeh or HoloViews; `serve` alone
+    # needs them
+    code = ("import sys\nfrom cli.main import main\n"
+            f"main(['card', {str(designs['axial'])!r}, '--freq', '10', '--amp-mm', '0.1', '--amp-rad', '0.01',"
+            f" '-o', {str(tmp_path / 'card.csv')!r}])\n"
+            "print(sorted(m for m in ('panel', 'bokeh', 'holoviews') if m in sys.modules))\n")
+    out = subprocess.run([sys.executable, "-c", code], cwd=Path(__file__).resolve().parents[1],
+                         capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+    assert (tmp_path / "card.csv").read_text().startswith("mode,")
