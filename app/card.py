@@ -14,6 +14,7 @@ from core.shape import long_shape_factor
 from . import plots, units
 from .bands import BAND_PARAMETERS
 from .curves import card_bands, card_sweeps, padded
+from .elements import ranged
 from .inputs import FloatInput
 from .live import LivePlot
 from .state import ExplorerState
@@ -70,11 +71,10 @@ class CardView(PlotView):
         for mode, b in (self.state.banded(lambda tol: card_bands(design, f, tol)) or {}).items():
             data[mode].update(b)
         self.table.object = self.summary(design, f, rows)
-        for which, modes in (("translation", TRANSLATIONS), ("rotation", ROTATIONS)):
-            dim = self.dims["displacement" if which == "translation" else "angle"]
-            dim.range = padded([data[m]["amplitude"] for m in modes], log=True)
+        dims = ranged(self.dims, {axis: padded([data[m]["amplitude"] for m in modes], log=True)
+                                  for axis, modes in (("displacement", TRANSLATIONS), ("angle", ROTATIONS))})
         at = {"translation": TRANSLATION.amplitude.to_display(x), "rotation": ROTATION.amplitude.to_display(angle)}
-        overlays = plots.card_overlays(data, self.dims, at)
+        overlays = plots.card_overlays(data, dims, at)
         self.plots = LivePlot.shown(self.plots, [overlays[w] for w in WHICH])
 
     @staticmethod

@@ -19,12 +19,6 @@ from bokeh.models import SaveTool
 from core.parameters import MODES
 from core.parameters import mode as mode_of
 
-# Without a GPU, Chromium draws WebGL through SwiftShader on the CPU: measured in the explorer,
-# the GPU process then spent about 110 ms per update (7 ms with canvas). HoloViews 1.23 asks for
-# WebGL by default; these plots are small (at most a few thousand points), canvas is the right
-# backend for them everywhere.
-hv.renderer("bokeh").webgl = False
-
 OPERATING_COLOR = "#e6550d"
 # one colour per mode (the card, the fit's predicted rows)
 MODE_COLORS = dict(zip(MODES, ("#1f77b4", "#2ca02c", "#d62728", "#9467bd")))
@@ -80,6 +74,35 @@ def dimensions(mode: str) -> dict[str, hv.Dimension]:
     }
 
 
+def ranged(dims: dict[str, hv.Dimension], ranges: dict) -> dict[str, hv.Dimension]:
+    """``dims`` with the axis ranges of ``ranges`` (name → (start, end), or None for the data's):
+    a new dict, each ranged dimension a clone. The dimensions given are never changed: an
+    element built on them earlier keeps its axes (a plot's elements share one clone, so plots of
+    the same quantity drawn with it still share their axis range)."""
+    out = dict(dims)
+    for name, rng in ranges.items():
+        if rng is not None and tuple(dims[name].range) != tuple(rng):
+            out[name] = _with_range(dims[name], tuple(rng))
+    return out
+
+
+_CLONES: dict = {}  # (id of a dimension, range) → (that dimension, its clone on the range)
+
+
+def _with_range(dim: hv.Dimension, rng: tuple) -> hv.Dimension:
+    """``dim`` cloned onto ``rng``; the same clone again for the same dimension and range (a clone
+    costs 0.15 ms, and a live view asks for the same few on every change). The entry holds the
+    dimension, so its id is not reused while cached; a few hundred entries at most."""
+    hit = _CLONES.get((id(dim), rng))
+    if hit is not None and hit[0] is dim:
+        return hit[1]
+    if len(_CLONES) >= 512:
+        _CLONES.clear()
+    clone = dim.clone(range=rng)
+    _CLONES[(id(dim), rng)] = (dim, clone)
+    return clone
+
+
 # ---- styled templates ----------------------------------------------------------------------------
 
 
@@ -96,6 +119,18 @@ def legend_outside(plot, _element):
         if legend.__class__.__name__ == "Legend":
             fig.center.remove(legend)
             fig.add_layout(legend, "right")
+
+
+def canvas(plot, _element):
+    """A hook drawing the plot on an HTML canvas, whatever the renderer's ``webgl`` says.
+
+    Without a GPU, Chromium draws WebGL through SwiftShader on the CPU: measured in the explorer,
+    the GPU process then spent about 110 ms per update (7 ms with canvas). HoloViews 1.23 asks for
+    WebGL by default; these plots are small (at most a few thousand points), canvas is the right
+    backend for them everywhere. A hook of each plot rather than ``hv.renderer("bokeh").webgl``,
+    which would change every plot of a notebook that imports the plotting API."""
+    if plot.state.output_backend != "canvas":
+        plot.state.output_backend = "canvas"
 
 
 @functools.cache
@@ -165,7 +200,7 @@ def scatter(x, y, xdim, ydim, label, **style):
 def overlay(items, title, png, *, logx=False, logy=False, legend="right", height=300):
     legend_opts = {"click_policy": "mute", "label_text_font_size": "11px", "spacing": 0, "padding": 4,
                    "margin": 4}
-    hooks = [png_name(png)] + ([legend_outside] if legend == "right" else [])
+    hooks = [canvas, png_name(png)] + ([legend_outside] if legend == "right" else [])
     options = {"title": title, "responsive": True, "height": height, "logx": logx, "logy": logy,
                "framewise": True, "hooks": hooks, "legend_opts": legend_opts,
                "fontsize": {"title": "13px"}, "show_legend": legend is not None}

@@ -4,7 +4,6 @@ sliders, and the status line above the tabs. Widgets write the state; the state 
 from __future__ import annotations
 
 import math
-import typing
 
 import panel as pn
 from bokeh.models import CustomJSTickFormatter
@@ -18,22 +17,19 @@ from .units import OPERATING_FREQUENCIES
 
 
 class FloatInput(pn.widgets.FloatInput):
-    """Panel's FloatInput without the 50 ms debounce on its value: every edit answers at once
-    (Panel marks such properties as priority changes, as its Tabulator does for its data)."""
-
-    _priority_changes: typing.ClassVar[list[str]] = ["value"]
+    """Panel's FloatInput; in a served app without the 50 ms debounce on its value, every edit
+    answering at once (:func:`app.patches.send_values_at_once`, installed by ``create_app``)."""
 
 
 class IntInput(pn.widgets.IntInput):
-    """Panel's IntInput without the 50 ms debounce on its value (see :class:`FloatInput`)."""
-
-    _priority_changes: typing.ClassVar[list[str]] = ["value"]
+    """Panel's IntInput; served, without the debounce on its value (see :class:`FloatInput`)."""
 
 
 class FloatSlider(pn.widgets.FloatSlider):
-    """Panel's FloatSlider without the 50 ms debounce on its value (see :class:`FloatInput`)."""
+    """Panel's FloatSlider; served, without the debounce on its value (see :class:`FloatInput`)."""
 
-    _priority_changes: typing.ClassVar[list[str]] = ["value"]
+
+IMMEDIATE = (FloatInput, IntInput, FloatSlider)  # the app's number widgets, for app.patches
 
 
 class LogSlider(pn.viewable.Viewer):

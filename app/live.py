@@ -18,7 +18,7 @@ Three costs that were measured here and are avoided (explorer, Chromium, this ma
   (:func:`app.patches.frozen_models`) the plots' own freezes walk nothing, and the outer one
   walks only if the change added or removed models; one ``hold`` sends every change in one
   message.
-* **No WebGL** (:mod:`app.plots`).
+* **No WebGL** (:func:`app.elements.canvas`, a hook of every plot).
 """
 
 from __future__ import annotations
@@ -37,17 +37,23 @@ from . import patches
 log = logging.getLogger("bushing.app")
 
 
+def _axes(element: hv.Element) -> list:
+    return [(d.name, d.label, d.unit, tuple(d.range)) for d in element.dimensions()]
+
+
 def _same_data(a: hv.Element, b: hv.Element) -> bool:
-    """Whether two elements of the same kind hold the same values in the same columns (the value
-    columns first: after a change of the design they differ, and the comparison stops there)."""
+    """Whether two elements of the same kind hold the same values in the same columns, on the same
+    axes (names, units and ranges: the ranges are set per element, and an element kept with an
+    earlier range would widen its plot's axis to it). The value columns are compared first: after a
+    change of the design they differ, and the comparison stops there."""
     if a is b:
         return True
     if type(a) is not type(b) or a.label != b.label or a.group != b.group:
         return False
     if isinstance(a, (hv.VLine, hv.HLine)):
-        return a.data == b.data
-    dims_a, dims_b = a.dimensions(), b.dimensions()
-    if [(d.name, d.label, d.unit) for d in dims_a] != [(d.name, d.label, d.unit) for d in dims_b] or len(a) != len(b):
+        return a.data == b.data and _axes(a) == _axes(b)
+    dims_a = a.dimensions()
+    if _axes(a) != _axes(b) or len(a) != len(b):
         return False
     for i in reversed(range(len(dims_a))):
         x, y = a.dimension_values(i), b.dimension_values(i)

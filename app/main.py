@@ -214,10 +214,9 @@ class App(pn.viewable.Viewer):
 
 def create_app():
     """Factory for one session (served per connection, so sessions never share state)."""
+    patches.install(pn.state.curdoc)  # the library hooks (once) and the page's BokehJS patches
     app = App()
     app.sync_url()
-    if pn.state.curdoc is not None and os.environ.get("BUSHING_BOKEHJS_PATCHES", "1") == "1":
-        patches.install_bokehjs_patches(pn.state.curdoc)
     return app.template()
 
 

@@ -17,6 +17,7 @@ from core.synthetic import paper_b_example
 
 from . import curves, misfit_plots
 from .curves import padded
+from .elements import ranged
 from .live import LivePlot
 from .state import ExplorerState
 from .uploads import csv_dropper, on_files, on_upload
@@ -136,12 +137,11 @@ class MeasuredView(PlotView):
             self.prediction.object = None if data is None else misfit_plots.prediction_overlay(data)
 
     def _draw(self, points, residuals):
-        mode = self.state.design.mode
-        self.dims_for(mode)
-        if points is not None:  # plots of the same quantity share the axis: one range for both
-            self.dims["residual_magnitude"].range = padded([residuals["magnitude_residual_pct"]])
-            self.dims["residual_loss"].range = padded([residuals["loss_factor_residual"]])
-        overlays = misfit_plots.residual_overlays(points, residuals, self.dims)
+        dims = self.dims_for(self.state.design.mode)
+        if points is not None:  # plots of the same quantity share the axis: one range (one clone) for both
+            dims = ranged(dims, {"residual_magnitude": padded([residuals["magnitude_residual_pct"]]),
+                                 "residual_loss": padded([residuals["loss_factor_residual"]])})
+        overlays = misfit_plots.residual_overlays(points, residuals, dims)
         items = [overlays[k] for k in RESIDUALS]
         self.residuals = LivePlot.shown(self.residuals, items)
 

@@ -18,6 +18,7 @@ from .elements import (
     curve,
     dimensions,
     overlay,
+    ranged,
     scatter,
     styled,
     sweep_label,
@@ -96,14 +97,14 @@ def diagnosis_overlays(diagnosis) -> dict:
     step), ``"curves"`` (|K| and the loss factor: data, baseline, final model) and ``"maps"``
     (the misfit before, then after: |K| and the loss factor each, on one colour scale per
     quantity); ``"groups"`` the curves' amplitude groups (:func:`app.curves.curve_groups`)."""
-    dims = dimensions(diagnosis.final.design.mode)
     stages = curves.gap_stages(diagnosis)
-    dims["gap"].range = (0.0, 1.1 * max(float(np.max(stages["gap"])), stages["noise"] or 0.0))
     groups = curves.curve_groups(diagnosis)
-    for i, quantity in enumerate(("magnitude", "loss_factor")):  # the data and both models in view
-        dims[quantity].range = curves.padded([v for g in groups for v in (g["data"][i], g["baseline"][i], g["final"][i])])
     base, final = curves.misfit_points(diagnosis, "baseline"), curves.misfit_points(diagnosis, "final")
-    dims["amplitude"].range = curves.padded([final["amplitude"]], log=True)
+    ranges = {"gap": (0.0, 1.1 * max(float(np.max(stages["gap"])), stages["noise"] or 0.0)),
+              "amplitude": curves.padded([final["amplitude"]], log=True)}
+    for i, quantity in enumerate(("magnitude", "loss_factor")):  # the data and both models in view
+        ranges[quantity] = curves.padded([v for g in groups for v in (g["data"][i], g["baseline"][i], g["final"][i])])
+    dims = ranged(dimensions(diagnosis.final.design.mode), ranges)
     maps = []
     for which, m in (("baseline", base), ("final", final)):
         for column, name in (("magnitude_pct", "|K| misfit (%)"), ("loss_factor", "loss-factor misfit")):

@@ -1,7 +1,11 @@
 """The one place where the app uses a library's private internals (each measured to matter).
 
 Checked against Panel 1.9 and Bokeh 3.9 (``pyproject.toml`` pins ``panel<1.10`` and
-``bokeh<3.10``); ``tests/test_app.py`` fails if an internal is gone or no longer takes effect.
+``bokeh<3.10``); ``tests/test_app_page.py`` fails if an internal is gone or no longer takes effect.
+
+Importing this module changes nothing: :func:`install` (called by :func:`app.main.create_app`,
+once per session; it installs each hook once) puts the process-wide hooks in place and the
+BokehJS patches in the session's page. A notebook that imports the plotting API gets none of them.
 
 **Model recomputation.** Every HoloViews plot update freezes the Bokeh document's models, and
 Bokeh recomputes the set of models (a walk over every model's properties) whenever the last
@@ -29,28 +33,63 @@ A/B twice: Chromium's renderer 59–60 ms per change with them, 71–82 ms witho
 page holds an HTML pane, in case one holds math (holoviz/panel#8424; holoviz/panel#8179 would
 load it late instead). The explorer's texts hold none: the bundle is sent only to a page whose
 texts have math delimiters. Measured here: about 0.1 s of each page load.
+
+**Number edits without debounce** (:func:`send_values_at_once`). Panel holds every change of a
+widget's property from the page for 50 ms (``Syncable._debounce``) before processing it, in case
+another follows, except the properties a class lists in its private ``_priority_changes`` (as
+Panel's Tabulator does for its data). The app's number inputs and sliders (:data:`app.inputs.IMMEDIATE`)
+list ``value``: every typed or dragged number is processed at once. That is 50 ms less per edit
+by construction, and it is also correct behaviour: with the debounce, a click right after typing
+(the design form's "Find designs") was processed before the typed value, on the old one.
 """
 
 from __future__ import annotations
 
 import contextlib
+import os
 import re
+import weakref
 
 from panel.io import resources as panel_resources
 from panel.models.markup import HTML as PanelHTML
+from panel.reactive import Syncable
 
 MATH_DELIMITERS = re.compile(r"\$\$|\\\(|\\\[")
-PATCHED = hasattr(panel_resources, "_panel_use_mathjax")
+# the Panel internals the hooks replace or extend are there (a test fails if not)
+PATCHED = hasattr(panel_resources, "_panel_use_mathjax") and hasattr(Syncable, "_priority_changes")
+_installed = False
+_pages = weakref.WeakSet()  # documents that have the BokehJS patches
+
+
+def install(doc=None) -> None:
+    """Put the hooks of this module in place, each once however often it is called: the MathJax
+    decision and the number edits without debounce (process-wide), and the BokehJS paint patches
+    in the page of ``doc`` (if given, unless ``BUSHING_BOKEHJS_PATCHES=0``)."""
+    global _installed
+    if not _installed:
+        if hasattr(panel_resources, "_panel_use_mathjax"):
+            panel_resources._panel_use_mathjax = holds_math
+        from .inputs import IMMEDIATE
+
+        send_values_at_once(IMMEDIATE)
+        _installed = True
+    if doc is not None and doc not in _pages and os.environ.get("BUSHING_BOKEHJS_PATCHES", "1") == "1":
+        install_bokehjs_patches(doc)
+        _pages.add(doc)
+
+
+def send_values_at_once(classes) -> None:
+    """Panel widget classes (the app's own subclasses) whose ``value`` from the page is processed
+    at once, without Panel's 50 ms debounce (see the module)."""
+    for cls in classes:
+        if "value" not in cls._priority_changes:
+            cls._priority_changes = [*cls._priority_changes, "value"]  # the class's own list
 
 
 def holds_math(roots) -> bool:
     """Whether any Panel HTML model under ``roots`` has text with math delimiters."""
     return any(isinstance(model, PanelHTML) and MATH_DELIMITERS.search(model.text or "")
                for root in roots for model in root.references())
-
-
-if PATCHED:
-    panel_resources._panel_use_mathjax = holds_math
 
 
 @contextlib.contextmanager

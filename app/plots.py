@@ -11,7 +11,8 @@ Plain functions, the same the explorer draws with; they need no server and work 
 
 Every axis is an :class:`holoviews.Dimension` with its name, label and unit
 (:func:`app.elements.dimensions`); plots of the same quantity share the dimension, so a layout
-links their axes. Amplitudes are in the display units of :mod:`app.units` (mm axially, rad in
+links their axes. Axis ranges are set per plot, on clones of the dimensions: nothing built earlier
+changes. Importing the API changes nothing global (each plot asks for canvas, not WebGL, itself). Amplitudes are in the display units of :mod:`app.units` (mm axially, rad in
 torsion), stiffnesses in kN/mm or N·m/rad, frequencies in Hz.
 
 Two layers: *element builders* (``loop_overlay``, ``sweep_overlay``, …; those of the model against
@@ -36,11 +37,13 @@ from .elements import (
     SWEEP_PALETTES,
     band_area,
     band_label,
+    canvas,
     curve,
     dimensions,
     marker,
     overlay,
     png_name,
+    ranged,
     scatter,
     sized,
     styled,
@@ -80,7 +83,7 @@ def strain_label(ratio: float) -> str:
 def sensitivity_bars(bars: hv.Bars, title: str, color: str, png: str) -> hv.Bars:
     """Sensitivities as a bar chart, largest first (:mod:`core.whatif.sensitivity`)."""
     return bars.opts(title=title, color=color, responsive=True, height=260, framewise=True, tools=["hover"],
-                     hooks=[png_name(png)], fontsize={"title": "13px"}, xrotation=0, show_legend=False)
+                     hooks=[canvas, png_name(png)], fontsize={"title": "13px"}, xrotation=0, show_legend=False)
 
 
 # ---- the explorer's plots ------------------------------------------------------------------------
@@ -143,20 +146,25 @@ def explorer_labels(data: curves.ExplorerData) -> dict:
 
 def explorer_overlays(data: curves.ExplorerData, dims: dict | None = None, sweep_items: dict | None = None) -> dict:
     """The five plots of ``data`` (:func:`app.curves.explorer_data`): ``"loop"`` and one per (quantity,
-    against) of :data:`TITLES`. ``dims`` are the dimensions to draw on: their ranges are set to
-    the data's (a live view passes its own, so that its plots keep their axes);
-    ``sweep_items`` may give the sweep curves of each plot, already built (a live view keeps
-    them while only the operating point moves)."""
-    dims = dims if dims is not None else dimensions(data.mode)
-    for name, rng in data.ranges.items():
-        if rng is not None:
-            dims[name].range = rng
+    against) of :data:`TITLES`. ``dims`` are the dimensions to draw on (a live view passes its
+    own, so that its plots keep their axes); the plots carry the data's ranges on clones of them
+    (:func:`app.elements.ranged`), ``dims`` are left as they are. ``sweep_items`` may give the
+    sweep curves of each plot, already built (a live view keeps them while only the operating
+    point moves); those on other ranges are put on the plot's (new curves with the same data, kept
+    in ``sweep_items`` for the next call)."""
+    dims = ranged(dims if dims is not None else dimensions(data.mode), data.ranges)
     out = {"loop": loop_overlay(data.loop, dims, reference=data.reference_loop, measured=data.measured_loop)}
     labels = explorer_labels(data)
     for (quantity, against) in TITLES:
         items = (sweep_items or {}).get((quantity, against))
         if items is None:
             items = sweep_curves(quantity, against, data.sweeps[against], dims, labels[against])
+        elif any(tuple(el.kdims[0].range) != tuple(dims[against].range)
+                 or tuple(el.vdims[0].range) != tuple(dims[quantity].range) for el in items):
+            # every element of a plot carries its ranges: one without would cost HoloViews a look
+            # at its data on every update (measured: about 5 ms per change on the explorer)
+            items = sweep_items[(quantity, against)] = [el.clone(kdims=[dims[against]], vdims=[dims[quantity]])
+                                                        for el in items]
         out[(quantity, against)] = sweep_overlay(
             quantity, against, items, dims, operating=data.operating[against],
             at=data.frequency_hz if against == "frequency" else data.amplitude,
@@ -277,8 +285,9 @@ def loop_shape_overlay(lp: dict, dims: dict, title: str = "Loop shape during the
     """A loop scaled to its peak drive and peak force, branch by branch: its shape alone."""
     x = lp["displacement"] / np.max(np.abs(lp["displacement"]))
     peak = np.max(np.abs(lp["force"]))
-    xd, fd = dims["drive_rel"], dims["force_rel"]
-    xd.range, fd.range = (-1.05, 1.05), (-1.1, 1.1)  # scaled to ±1: the same axes for every loop
+    # scaled to ±1: the same axes for every loop
+    scaled = ranged(dims, {"drive_rel": (-1.05, 1.05), "force_rel": (-1.1, 1.1)})
+    xd, fd = scaled["drive_rel"], scaled["force_rel"]
     items = [curve(x, lp["force"] / peak, xd, fd, "total", color="black", line_width=2.5)]
     items += [curve(x, lp[f"force_{name}"] / peak, xd, fd, name, color=color, line_width=1.5)
               for name, color in BRANCH_COLORS.items()]

@@ -8,6 +8,7 @@ import param
 
 from . import plots
 from .curves import padded
+from .elements import ranged
 from .live import LivePlot
 from .state import ExplorerState
 from .views import PlotView
@@ -35,10 +36,8 @@ class SlicesView(PlotView):
 
     def _update(self):
         data = self.state.slice_comparison()
-        mode = self.state.design.mode
-        self.dims_for(mode)
-        self.dims["amplitude"].range = padded([data["amplitude"]], log=True)
-        overlays = plots.slices_overlays(data, self.dims, self.state.amplitude)
+        dims = ranged(self.dims_for(self.state.design.mode), {"amplitude": padded([data["amplitude"]], log=True)})
+        overlays = plots.slices_overlays(data, dims, self.state.amplitude)
         items = [overlays[w] for w in WHICH]
         self.plots = LivePlot.shown(self.plots, items, taps={i: self.tap_amplitude for i in range(len(WHICH))})
         self.table.object = self.summary(data)

@@ -9,6 +9,7 @@ import param
 
 from . import plots
 from .curves import padded
+from .elements import ranged
 from .live import LivePlot, update_or_keep
 from .state import ExplorerState
 from .views import PlotView
@@ -56,13 +57,11 @@ class TeachingView(PlotView):
 
     def _update(self):
         d = self.state.branch_breakdown()
-        mode = self.state.design.mode
-        self.dims_for(mode)
         totals = {which: sum(d[which].values()) for which in WHICH}
-        self.dims["amplitude"].range = padded([d["amplitude"]], log=True)
-        self.dims["real"].range = padded([np.zeros(1), totals["real"]])
-        self.dims["branch_loss"].range = padded([np.zeros(1), totals["loss"]])
-        overlays = plots.branch_overlays(d, self.dims, self.state.amplitude)
+        dims = ranged(self.dims_for(self.state.design.mode), {
+            "amplitude": padded([d["amplitude"]], log=True), "real": padded([np.zeros(1), totals["real"]]),
+            "branch_loss": padded([np.zeros(1), totals["loss"]])})
+        overlays = plots.branch_overlays(d, dims, self.state.amplitude)
         items = [overlays[w] for w in WHICH]
         self.branches = LivePlot.shown(self.branches, items, taps={0: self.tap_amplitude, 1: self.tap_amplitude})
         self._draw_frame()

@@ -27,8 +27,8 @@ class PlotView(pn.viewable.Viewer):
         super().__init__(state=state, **params)
 
     def dims_for(self, mode: str) -> dict:
-        """The view's dimensions (:func:`app.elements.dimensions`): kept while the mode is, so that
-        the ranges set on them are the plots'; new with new units."""
+        """The view's dimensions (:func:`app.elements.dimensions`): kept while the mode is, new with
+        new units; never changed (each update puts its ranges on clones, :func:`app.elements.ranged`)."""
         if mode != self._mode:
             self.dims, self._mode = dimensions(mode), mode
         return self.dims

@@ -110,13 +110,20 @@ def test_the_page_has_no_webgl_and_each_plot_saves_its_own_png(app):
     assert names["Hysteresis loop at the operating point"] == ["bushing-hysteresis-loop"]
 
 
-def test_the_mathjax_patch_is_in_effect():
-    """app.patches changes one Panel internal: fail loudly when a Panel upgrade removes it."""
+def test_the_panel_patches_are_in_effect():
+    """app.patches changes two Panel internals (installed by create_app): fail loudly when a
+    Panel upgrade removes them."""
+    import inspect
+
     from panel.io import resources
+    from panel.reactive import Syncable
 
     from app import patches
 
+    patches.install()
     assert patches.PATCHED and resources._panel_use_mathjax is patches.holds_math
+    # Panel still reads the priority list where it schedules a change from the page
+    assert "in self._priority_changes" in inspect.getsource(Syncable._server_change)
 
 
 def test_the_slider_keeps_its_own_position(app):

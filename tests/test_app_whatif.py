@@ -156,6 +156,9 @@ def test_no_number_field_of_any_tab_waits_before_it_sends_its_value(app):
     Every typed or dragged number in the app sends its value at once (app.inputs)."""
     import panel as pn
 
+    from app import patches
+
+    patches.install()  # as create_app does for every session
     for name in ("slices", "teaching", "card", "measured", "diagnosis", "whatif"):
         app.view(name)
     numbers = (pn.widgets.FloatInput, pn.widgets.IntInput, pn.widgets.FloatSlider, pn.widgets.IntSlider,

@@ -74,3 +74,60 @@ def test_widths(width, expected):
     rendered = list(hv.render(layout).select({"type": Plot}))
     assert len(rendered) == 3 and {(p.width, p.sizing_mode) for p in rendered} == {expected}
     assert all(ov.opts.get().kwargs.get("responsive") is (width is None) for ov in layout)
+
+
+def axes(overlay):
+    """Every dimension of every element of ``overlay``, with its range."""
+    return [(d.name, tuple(d.range)) for el in overlay for d in el.dimensions()]
+
+
+def test_a_plot_keeps_its_axes_when_the_same_dimensions_draw_another_design():
+    """Ranges are set per plot: drawing a very different design on the same dimensions (as a live
+    view does) leaves the plots built before, and the dimensions passed, as they were."""
+    from app import curves
+
+    dims = plots.dimensions("axial")
+    given = [(d.name, tuple(d.range)) for d in dims.values()]
+    stiff = PAPER_B.replace(shear_modulus=100 * PAPER_B.material.shear_modulus)
+    first = plots.explorer_overlays(curves.explorer_data(PAPER_B, 10.0, 0.1), dims)
+    shape = plots.loop_shape_overlay(curves.hysteresis_loop(PAPER_B, 10.0, 0.1), dims)
+    before = {k: axes(ov) for k, ov in first.items()}
+    k_f = first[("magnitude", "frequency")]
+    assert k_f.get(0).vdims[0].range[1] < 1e3  # |K| in kN/mm: PAPER_B's
+    second = plots.explorer_overlays(curves.explorer_data(stiff, 50.0, 0.5, freq_range=(100.0, 200.0)), dims)
+    assert second[("magnitude", "frequency")].get(0).vdims[0].range[0] > k_f.get(0).vdims[0].range[1]
+    assert {k: axes(ov) for k, ov in first.items()} == before
+    assert [(d.name, tuple(d.range)) for d in dims.values()] == given
+    assert ("drive_rel", (-1.05, 1.05)) in axes(shape) and ("drive_rel", (None, None)) in given
+
+
+def test_importing_the_plotting_api_changes_nothing_global():
+    """Importing app.plots leaves HoloViews' Bokeh renderer (WebGL on by default) and its
+    options as they were; the plots ask for canvas themselves."""
+    import subprocess
+    import sys
+
+    code = """
+import holoviews as hv, holoviews.plotting.bokeh
+def snapshot():
+    r = hv.renderer("bokeh")
+    return (sorted((k, repr(v)) for k, v in r.param.values().items()), hv.Store.current_backend,
+            sorted(hv.Store.options().keys()), len(hv.Store.custom_options()))
+before = snapshot()
+import app.plots, app.elements
+print(before == snapshot(), hv.renderer("bokeh").webgl)
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["True", "True"], out.stdout
+
+
+def test_the_plots_draw_on_canvas_with_webgl_asked_for():
+    renderer = hv.renderer("bokeh")
+    webgl = renderer.webgl
+    renderer.webgl = True  # HoloViews' default, as in a notebook
+    try:
+        layout = plots.explorer_plots(PAPER_B, 10.0, 0.1)
+        figs = list(hv.render(layout).select({"type": Plot}))
+    finally:
+        renderer.webgl = webgl
+    assert len(figs) == 5 and {f.output_backend for f in figs} == {"canvas"}
