@@ -167,11 +167,9 @@ class Session:
         # arrays decoded, models updated) does not delay the reading of the next message
         self.arrivals: list[tuple[float, bool, int, object]] = []
         self._apply = self.session._handle_patch
-        self.session._handle_patch = lambda message: self.arrivals.append(
-            (time.perf_counter(), self._only_url(message), cpu_ns(self.pid), message))
-        # the connection reads messages for as long as the loop runs (run_sync below)
-        self.conn._until_predicate = None
-        self.loop.add_callback(self.conn._next)
+        # messages are read for as long as the loop runs (run_sync below), in a loop: Bokeh's own
+        # reader recurses once per message and ends in a RecursionError after a few hundred
+        self.loop.add_callback(self._read)
         self.doc.callbacks.send_event(DocumentReady())  # what a page sends once rendered
         t0 = time.perf_counter()
         self.loop.run_sync(lambda: self._settle(lambda: time.perf_counter() - t0 > 2 * quiet, t0))
@@ -180,6 +178,11 @@ class Session:
     def _apply_received(self):
         for *_figures, message in self.arrivals:
             self._apply(message)
+
+    async def _read(self):
+        while (message := await self.conn._pop_message()) is not None:
+            if message.msgtype == "PATCH-DOC":
+                self.arrivals.append((time.perf_counter(), self._only_url(message), cpu_ns(self.pid), message))
 
     def _only_url(self, message) -> bool:
         ids = {m.id for m in self.doc.models if type(m).__name__ == "Location"}
