@@ -220,3 +220,17 @@ def test_a_latin_hypercube_puts_one_point_in_each_stratum_of_every_column():
         assert sorted(np.floor(column * 12).astype(int)) == list(range(12))
     assert np.array_equal(points, latin_hypercube(12, 3, seed=4))
     assert not np.array_equal(points, latin_hypercube(12, 3, seed=5))
+
+
+def test_the_first_key_given_twice_is_named_in_any_object_size():
+    # the keys of one object are counted in one pass: a file of a hundred thousand keys (within
+    # the 1 MB limit) is read in one pass, and of several repeated keys the first in order is named
+    from core.rules import Words, strict_json
+
+    keys = [f"k{i}" for i in range(100_000)] + ["k7", "k3", "k7"]
+    text = "{" + ",".join(f'"{k}": 1' for k in keys) + "}"
+    with pytest.raises(RuleError) as info:
+        strict_json(text, 10**7, Words(twice="{key} twice", key_twice=True), RuleError)
+    assert (info.value.key, info.value.code) == ("k3", "duplicate_key")
+    assert len(strict_json("{" + ",".join(f'"{k}": 1' for k in keys[:100_000]) + "}", 10**7, Words(),
+                           RuleError)) == 100_000
