@@ -11,7 +11,15 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 
 from .parameters import BY_NAME
-from .rules import ORDER_RANGE, OUT_OF_RANGE, OUTER_NOT_LARGER, DesignError, number, positive
+from .rules import (
+    ORDER_RANGE,
+    OUT_OF_RANGE,
+    OUTER_NOT_LARGER,
+    DesignError,
+    number,
+    positive,
+    within,
+)
 
 SIZE_RANGE = (1e-6, 1e3)  # m: radii and lengths from a micrometre to a kilometre, no further
 MAX_MODULUS = 1e12  # Pa: µ, m and σ_fmax at most 1 TPa (diamond's shear modulus is about half that)
@@ -44,11 +52,7 @@ class Geometry:
     def __post_init__(self):
         for f in fields(self):
             key = f"geometry.{f.name}"
-            value = positive(key, getattr(self, f.name))
-            if not SIZE_RANGE[0] <= value <= SIZE_RANGE[1]:
-                raise DesignError(key, f"must lie between {SIZE_RANGE[0]:g} and {SIZE_RANGE[1]:g} m, got {value!r}",
-                                  OUT_OF_RANGE)
-            object.__setattr__(self, f.name, value)
+            object.__setattr__(self, f.name, within(key, getattr(self, f.name), *SIZE_RANGE, "m"))
         if self.outer_radius <= self.inner_radius:
             raise DesignError(
                 "geometry.outer_radius",
@@ -97,10 +101,7 @@ class Material:
                 if not 0.0 < value <= 1.0:
                     raise DesignError(key, f"must lie in (0, 1], got {value!r}", ORDER_RANGE)
             elif f.name == "friction_strain_half":
-                value = positive(key, value)
-                if not STRAIN_HALF_RANGE[0] <= value <= STRAIN_HALF_RANGE[1]:
-                    raise DesignError(key, f"must lie between {STRAIN_HALF_RANGE[0]:g} and {STRAIN_HALF_RANGE[1]:g}, "
-                                      f"got {value!r}", OUT_OF_RANGE)
+                value = within(key, value, *STRAIN_HALF_RANGE)
             else:
                 value = positive(key, value)
                 if value > MAX_MODULUS:

@@ -183,6 +183,17 @@ def positive(key: str, value: Any, error: type[RuleError] = DesignError) -> floa
     return finite
 
 
+def within(key: str, value: Any, low: float, high: float, unit: str = "",
+           error: type[RuleError] = DesignError) -> float:
+    """:func:`positive`, and from ``low`` to ``high`` inclusive (``unit`` named in the words);
+    else ``error`` with the code ``out_of_range``."""
+    finite = positive(key, value, error)
+    if not low <= finite <= high:
+        raise error(key, f"must lie between {low:g} and {high:g}{' ' + unit if unit else ''}, got {finite!r}",
+                    OUT_OF_RANGE)
+    return finite
+
+
 def is_number(value: Any) -> bool:
     """Whether :func:`number` takes ``value``."""
     try:
