@@ -11,6 +11,7 @@ import math
 import param
 
 from core.parameters import MATERIAL, PARAMETERS
+from core.rules import RuleError, decimal
 from core.whatif.tolerance import SAMPLES, FitCovariance, ToleranceError, Tolerances
 
 # a parameter's key in the tolerances of a link (tol=mu:10,L:1)
@@ -26,8 +27,8 @@ def parse_tolerances(text: str) -> dict[str, float]:
         key, _, value = item.partition(":")
         name = _TOLERANCE_NAMES.get(key.strip())
         try:
-            number = float(value)
-        except ValueError:
+            number = decimal(value)  # the one number rule: no "1_0", "nan" or other digits
+        except RuleError:
             number = math.nan
         if name is None or name in out or not 0.0 <= number <= 89.0:
             raise ToleranceError(f"the tolerances {text[:80]!r}: give key:percent pairs, keys from "

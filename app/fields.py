@@ -28,14 +28,9 @@ ERROR_FIELD = {f"{p.group}.{p.name}": p.field for p in PARAMETERS}
 _INNER, _OUTER, _LENGTH = BY_NAME["inner_radius"].field, BY_NAME["outer_radius"].field, BY_NAME["length"].field
 
 
-def value_of(design: Design, p: DesignParameter) -> float:
-    """The value of parameter ``p`` in ``design`` (SI)."""
-    return getattr(getattr(design, p.group), p.name)
-
-
 def display_values(design: Design) -> dict[str, float]:
     """The fields that show ``design`` (display units, to 12 digits: no 19.200000000000003)."""
-    return {name: float(f"{p.unit.to_display(value_of(design, p)):.12g}") for name, p in DESIGN_FIELDS.items()}
+    return {name: float(f"{p.unit.to_display(design.value(p.name)):.12g}") for name, p in DESIGN_FIELDS.items()}
 
 
 def _field(p: DesignParameter, default: float) -> param.Number:

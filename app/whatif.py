@@ -19,7 +19,6 @@ from core.whatif.target import Found, TargetError, solve
 from core.whatif.tolerance import ToleranceError
 
 from . import plots, units
-from .fields import value_of
 from .inputs import FloatInput, IntInput
 from .live import LivePlot
 from .state import ExplorerState
@@ -308,6 +307,6 @@ def found_values(design, sep: str, names=tuple(FOUND_COLUMNS), symbols: bool = F
     cells = []
     for n in names:
         p = BY_NAME[n]
-        text = f"{p.unit.to_display(value_of(design, p)):{FOUND_COLUMNS[n]}}"
+        text = f"{p.unit.to_display(design.value(p.name)):{FOUND_COLUMNS[n]}}"
         cells.append(f"{p.symbol} {text}" if symbols else text)
     return sep.join(cells)

@@ -296,23 +296,17 @@ def _cmd_stiffness(args) -> None:
     result = stiffness(design, freqs, args.amp, slices=slices, route=args.route)
     table = result.table()
     if args.tolerance:
+        from core.io.tolerances import read_tolerances
         from core.whatif.tolerance import band, band_columns
 
-        tolerances = _read_tolerances(args.tolerance, fit_report)
+        # the design file's fit report, for a tolerance file that asks for the fit's covariance
+        tolerances = read_tolerances(args.tolerance, fit_report)
         if work * tolerances.samples > limit:
             raise InputError(f"bushing stiffness: {tolerances.samples} samples × {work} point-layers is more than "
                              f"{limit} for the {args.route} route; ask for fewer samples or points")
         table.update(band_columns(band(design, freqs[None, :], np.asarray(args.amp)[:, None], tolerances,
                                        slices=slices, route=args.route)))
     _write_csv(_finite(table), args.output)
-
-
-def _read_tolerances(path: str, fit_report: dict | None):
-    """The tolerance file, with the design file's fit report for when it asks for the fit's
-    covariance."""
-    from core.io.tolerances import read_tolerances
-
-    return read_tolerances(path, fit_report)
 
 
 def _cmd_design(args) -> None:

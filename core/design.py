@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any
 
 from .effects import EFFECTS, validate_effects
-from .parameters import DEFAULT_SHAPE, MODES, SHAPES, no_long_form
+from .parameters import BY_NAME, DEFAULT_SHAPE, MODES, SHAPES, no_long_form
 from .parts import Geometry, Material, as_dict
 from .rules import (
     BAD_CHOICE,
@@ -146,6 +146,21 @@ class Design:
     def strain_factor(self) -> float:
         """c with ε_eq = c·x̂ (eqs 14, 15 for long bushings; 1/m or 1/rad)."""
         return strain_factor(self.geometry, self.mode, self.shape)
+
+    def value(self, name: str) -> float:
+        """The geometric or material parameter called ``name``, in SI units.
+
+        Parameters
+        ----------
+        name : str
+            A name of :data:`core.parameters.NAMES` (``outer_radius``, ``shear_modulus``…).
+
+        Returns
+        -------
+        float
+            Its value: m for the geometry, Pa or Pa·s^α for the moduli, dimensionless for α and ε½.
+        """
+        return float(getattr(getattr(self, BY_NAME[name].group), name))
 
     def strain(self, amplitude):
         """The equivalent strain amplitude ε_eq = c·x̂ of a drive amplitude (eqs 14, 15).

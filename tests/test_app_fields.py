@@ -129,3 +129,11 @@ def test_each_field_shows_the_panel_words_of_the_core_s_rule():
     assert state.errors == {"shear_modulus_mpa": "Must be positive."}
     state.param.update(shear_modulus_mpa=2.42, fractional_order=1.5)
     assert state.errors == {"fractional_order": "Must lie in (0, 1]."}
+
+
+@pytest.mark.parametrize("text", ["mu:1_0", "mu:１０", "mu:١٠", "mu:nan", "mu:0x10"])
+def test_a_links_tolerance_follows_the_one_number_rule(text):
+    # as in the files and on the command line: plain ASCII decimals only (float() took 1_0 and １０)
+    with pytest.raises(ToleranceError):
+        parse_tolerances(text)
+    assert parse_tolerances("mu:10,L:1.5e0") == {"shear_modulus": 10.0, "length": 1.5}

@@ -16,7 +16,6 @@ from core.identify.fit import fit_global
 from core.parameters import MATERIAL as PARAMETERS
 from core.registry import parameter, parameter_values
 from core.residuals import gap
-from core.whatif.sensitivity import value_of
 from tests.test_material import _berg_loop_harmonic, reference_modulus
 from tests.test_shape import TABLE_ACCURACY, energy_strain_factor, fe_paper_b
 
@@ -42,7 +41,7 @@ def linear_shift_bounds(design, data, step=1e-5) -> np.ndarray:
     """To first order a least-squares fit moves the parameters from ``design``'s by
     (JᵀJ)⁻¹Jᵀr, r the misfit there; by Cauchy–Schwarz each component is at most
     √((JᵀJ)⁻¹ᵢᵢ) ‖r‖. J by central differences here, in the fit's coordinates."""
-    theta0 = fit_coordinates({n: value_of(design, n) for n in PARAMETERS})
+    theta0 = fit_coordinates({n: design.value(n) for n in PARAMETERS})
 
     def residual(theta):
         values = {n: float(np.exp(t)) if parameter(n).log else float(t) for n, t in zip(PARAMETERS, theta)}

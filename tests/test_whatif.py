@@ -20,7 +20,7 @@ from core.parameters import MATERIAL as PARAMETERS
 from core.registry import parameter
 from core.response import loss_factor
 from core.synthetic import synthetic_stiffness
-from core.whatif.sensitivity import elasticities, log_derivatives, sentence, value_of
+from core.whatif.sensitivity import elasticities, log_derivatives, sentence
 from core.whatif.target import TargetError, solve
 from core.whatif.tolerance import (
     FitCovariance,
@@ -102,7 +102,7 @@ def jacobian_covariance(design, data, names, step=1e-5):
     (ln p, α itself) at ``design``, J by central differences, s² the residual variance: the
     covariance a least-squares fit implies, by a route apart from core.identify.fit's."""
     log = [parameter(n).log for n in names]
-    theta0 = np.array([np.log(value_of(design, n)) if lg else value_of(design, n) for n, lg in zip(names, log)])
+    theta0 = np.array([np.log(design.value(n)) if lg else design.value(n) for n, lg in zip(names, log)])
 
     def residual(theta):
         values = {n: float(np.exp(t)) if lg else float(t) for n, lg, t in zip(names, log, theta)}

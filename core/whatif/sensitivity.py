@@ -24,11 +24,6 @@ from ..response import loss_factor
 STEP = 1e-4  # the step in ln p of the central differences
 
 
-def value_of(design: Design, name: str) -> float:
-    """A geometric or material parameter of ``design`` by name (SI)."""
-    return float(getattr(getattr(design, BY_NAME[name].group), name))
-
-
 def log_derivatives(design: Design, frequency_hz, amplitude, names=NAMES,
                     step: float = STEP, **kwargs) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """∂|K|/∂ln p and ∂η/∂ln p of every parameter in ``names`` at the points (``frequency_hz``,
@@ -36,7 +31,7 @@ def log_derivatives(design: Design, frequency_hz, amplitude, names=NAMES,
     parameter's range). ``kwargs`` go to :func:`core.bushing.stiffness_points`."""
     out = {}
     for name in names:
-        p = value_of(design, name)
+        p = design.value(name)
         ends = []
         for sign in (1.0, -1.0):
             try:

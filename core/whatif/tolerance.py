@@ -60,7 +60,7 @@ from ..rules import (
     is_number,
     whole_number,
 )
-from .sensitivity import log_derivatives, value_of
+from .sensitivity import log_derivatives
 
 DISTRIBUTIONS = ("uniform", "normal")
 SAMPLES = 500  # the default sample count
@@ -107,7 +107,7 @@ class FitCovariance:
                                  "error): its covariance cannot make a band; give a tolerance for it instead", NOT_FINITE)
         if not names:
             raise ToleranceError("fit_covariance", "the fit report holds no material parameter", MISSING_KEY)
-        sd = np.array([self.standard_errors[n] / (value_of(design, n) if parameter(n).log else 1.0) for n in names])
+        sd = np.array([self.standard_errors[n] / (design.value(n) if parameter(n).log else 1.0) for n in names])
         try:
             corr = np.array([[float(self.correlation[a][b]) for b in names] for a in names])
         except (KeyError, TypeError, ValueError):
@@ -169,7 +169,7 @@ class Tolerances:
 
     def half_widths(self, design: Design) -> dict[str, float]:
         """Every toleranced parameter's half-width in SI units (zero tolerances left out)."""
-        out = {n: h * value_of(design, n) for n, h in self.relative.items()}
+        out = {n: h * design.value(n) for n, h in self.relative.items()}
         out.update(self.absolute)
         return {n: h for n, h in out.items() if h > 0}
 
@@ -189,7 +189,7 @@ class Tolerances:
             raise ToleranceError("tolerances", f"a may reach {a_high:.4g} m and b fall to {b_low:.4g} m: "
                                  "some parts would have no rubber (b ≤ a)", OUTER_NOT_LARGER)
         for name, width in h.items():
-            low, high = value_of(design, name) - width, value_of(design, name) + width
+            low, high = design.value(name) - width, design.value(name) + width
             try:
                 design.replace(**{name: low})
                 design.replace(**{name: high})
@@ -206,10 +206,10 @@ class Tolerances:
         for name, width in sorted(self.half_widths(design).items()):
             u = rng.uniform(-1.0, 1.0, n) if self.distribution == "uniform" else \
                 _TRUNCATED.rvs(n, random_state=rng) / 3.0
-            out[name] = value_of(design, name) + width * u
+            out[name] = design.value(name) + width * u
         if self.covariance is not None:
             names, cov = self.covariance.matrix(design)
-            centre = np.array([math.log(value_of(design, p)) if parameter(p).log else value_of(design, p) for p in names])
+            centre = np.array([math.log(design.value(p)) if parameter(p).log else design.value(p) for p in names])
             theta = rng.multivariate_normal(centre, cov, n, method="eigh")
             for j, name in enumerate(names):
                 lo, hi = parameter(name).bounds
@@ -223,11 +223,11 @@ class Tolerances:
         names, sd = [], []
         for name, width in sorted(self.half_widths(design).items()):
             names.append(name)
-            sd.append(width * _UNIT_STD[self.distribution] / value_of(design, name))
+            sd.append(width * _UNIT_STD[self.distribution] / design.value(name))
         blocks = [np.diag(np.square(sd))]
         if self.covariance is not None:
             fit_names, cov = self.covariance.matrix(design)
-            to_log = np.array([1.0 if parameter(n).log else 1.0 / value_of(design, n) for n in fit_names])
+            to_log = np.array([1.0 if parameter(n).log else 1.0 / design.value(n) for n in fit_names])
             names += list(fit_names)
             blocks.append(cov * np.outer(to_log, to_log))
         return tuple(names), linalg.block_diag(*blocks)
@@ -323,12 +323,12 @@ def _closed_form_samples(design: Design, draws: list[dict[str, float]], f, x, sh
     def column(name: str) -> np.ndarray:
         if draws and name in draws[0]:
             return np.array([d[name] for d in draws]).reshape((n, *ones))
-        return np.full((n, *ones), value_of(design, name))
+        return np.full((n, *ones), design.value(name))
 
     geometry_varies = any(name in draws[0] for name in GEOMETRY) if draws else False
     if geometry_varies:
         s, c = _sample_factors(design.mode, design.shape, tuple(
-            tuple(d.get(name, value_of(design, name)) for name in GEOMETRY) for d in draws))
+            tuple(d.get(name, design.value(name)) for name in GEOMETRY) for d in draws))
         # the model's strain check on the sample of the largest strain factor (the largest
         # strains); the nominal design's was checked by the band
         widest = int(np.argmax(c))
