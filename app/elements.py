@@ -82,25 +82,8 @@ def ranged(dims: dict[str, hv.Dimension], ranges: dict) -> dict[str, hv.Dimensio
     out = dict(dims)
     for name, rng in ranges.items():
         if rng is not None and tuple(dims[name].range) != tuple(rng):
-            out[name] = _with_range(dims[name], tuple(rng))
+            out[name] = dims[name].clone(range=tuple(rng))
     return out
-
-
-_CLONES: dict = {}  # (id of a dimension, range) → (that dimension, its clone on the range)
-
-
-def _with_range(dim: hv.Dimension, rng: tuple) -> hv.Dimension:
-    """``dim`` cloned onto ``rng``; the same clone again for the same dimension and range (a clone
-    costs 0.15 ms, and a live view asks for the same few on every change). The entry holds the
-    dimension, so its id is not reused while cached; a few hundred entries at most."""
-    hit = _CLONES.get((id(dim), rng))
-    if hit is not None and hit[0] is dim:
-        return hit[1]
-    if len(_CLONES) >= 512:
-        _CLONES.clear()
-    clone = dim.clone(range=rng)
-    _CLONES[(id(dim), rng)] = (dim, clone)
-    return clone
 
 
 # ---- styled templates ----------------------------------------------------------------------------

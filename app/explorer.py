@@ -10,6 +10,7 @@ import param
 
 from . import plots
 from .bands import BAND_PARAMETERS
+from .elements import ranged
 from .live import LivePlot
 from .state import ExplorerState
 from .views import PlotView
@@ -50,7 +51,10 @@ class ExplorerPlots(PlotView):
             labels = plots.explorer_labels(data)
             self._sweeps = {k: plots.sweep_curves(*k, data.sweeps[k[1]], self.dims, labels[k[1]]) for k in GRID}
             self._sweeps_key = key
-        overlays = plots.explorer_overlays(data, self.dims, self._sweeps)
+        dims = ranged(self.dims, data.ranges)
+        # the kept sweeps on this update's ranges, kept so: re-ranged once per change of ranges
+        self._sweeps = {k: plots.on_ranges(items, dims, *k) for k, items in self._sweeps.items()}
+        overlays = plots.explorer_overlays(data, dims, self._sweeps)
         grid = [overlays[k] for k in GRID]
         if self.grid is None:
             taps = {i: self.tap_frequency if against == "frequency" else self.tap_amplitude

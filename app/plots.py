@@ -144,14 +144,25 @@ def explorer_labels(data: curves.ExplorerData) -> dict:
             "amplitude": [sweep_label(v, "Hz") for v in data.sweeps["amplitude"]["frequency_hz"]]}
 
 
+def on_ranges(items: list, dims: dict, quantity: str, against: str) -> list:
+    """A plot's sweep curves on the ranges of ``dims``: ``items`` themselves where they are on them,
+    else new curves of the same data. Every element of a plot carries its ranges: one without
+    would cost HoloViews a look at its data on every update (measured: about 5 ms per change)."""
+    if all(tuple(el.kdims[0].range) == tuple(dims[against].range)
+           and tuple(el.vdims[0].range) == tuple(dims[quantity].range) for el in items):
+        return items
+    return [el.clone(kdims=[dims[against]], vdims=[dims[quantity]]) for el in items]
+
+
 def explorer_overlays(data: curves.ExplorerData, dims: dict | None = None, sweep_items: dict | None = None) -> dict:
     """The five plots of ``data`` (:func:`app.curves.explorer_data`): ``"loop"`` and one per (quantity,
     against) of :data:`TITLES`. ``dims`` are the dimensions to draw on (a live view passes its
     own, so that its plots keep their axes); the plots carry the data's ranges on clones of them
     (:func:`app.elements.ranged`), ``dims`` are left as they are. ``sweep_items`` may give the
     sweep curves of each plot, already built (a live view keeps them while only the operating
-    point moves); those on other ranges are put on the plot's (new curves with the same data, kept
-    in ``sweep_items`` for the next call)."""
+    point moves); those on other ranges are put on the plot's (new curves with the same data).
+    ``sweep_items`` itself is not changed (a live view keeps its own on the ranges,
+    :func:`on_ranges`)."""
     dims = ranged(dims if dims is not None else dimensions(data.mode), data.ranges)
     out = {"loop": loop_overlay(data.loop, dims, reference=data.reference_loop, measured=data.measured_loop)}
     labels = explorer_labels(data)
@@ -159,12 +170,8 @@ def explorer_overlays(data: curves.ExplorerData, dims: dict | None = None, sweep
         items = (sweep_items or {}).get((quantity, against))
         if items is None:
             items = sweep_curves(quantity, against, data.sweeps[against], dims, labels[against])
-        elif any(tuple(el.kdims[0].range) != tuple(dims[against].range)
-                 or tuple(el.vdims[0].range) != tuple(dims[quantity].range) for el in items):
-            # every element of a plot carries its ranges: one without would cost HoloViews a look
-            # at its data on every update (measured: about 5 ms per change on the explorer)
-            items = sweep_items[(quantity, against)] = [el.clone(kdims=[dims[against]], vdims=[dims[quantity]])
-                                                        for el in items]
+        else:
+            items = on_ranges(items, dims, quantity, against)
         out[(quantity, against)] = sweep_overlay(
             quantity, against, items, dims, operating=data.operating[against],
             at=data.frequency_hz if against == "frequency" else data.amplitude,

@@ -131,3 +131,20 @@ def test_the_plots_draw_on_canvas_with_webgl_asked_for():
     finally:
         renderer.webgl = webgl
     assert len(figs) == 5 and {f.output_backend for f in figs} == {"canvas"}
+
+
+def test_the_explorer_s_plots_leave_the_sweep_curves_they_are_given_as_they_were():
+    """A builder of plots is a function of its arguments: sweep curves passed on other ranges are
+    drawn on the plot's (clones), and the caller's dict keeps its own curves."""
+    from app import curves
+
+    dims = plots.dimensions("axial")
+    data = curves.explorer_data(PAPER_B, 10.0, 0.1)
+    labels = plots.explorer_labels(data)
+    given = {k: plots.sweep_curves(*k, data.sweeps[k[1]], dims, labels[k[1]]) for k in plots.TITLES}
+    kept = {k: list(v) for k, v in given.items()}
+    out = plots.explorer_overlays(data, dims, given)
+    assert set(given) == set(kept) and all(given[k][i] is kept[k][i] for k in kept for i in range(len(kept[k])))
+    drawn = out[("magnitude", "frequency")].get(0)
+    assert tuple(drawn.vdims[0].range) == tuple(data.ranges["magnitude"])
+    assert tuple(given[("magnitude", "frequency")][0].vdims[0].range) == (None, None)
