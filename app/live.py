@@ -65,6 +65,22 @@ def _same_data(a: hv.Element, b: hv.Element) -> bool:
     return True
 
 
+def _shape(overlay) -> tuple | None:
+    """What HoloViews builds a plot from, numbers aside: each element's kind, key, style (its
+    options' id: the elements are clones of styled templates) and dimensions (names, labels,
+    units). Two frames of one shape differ in their numbers only (data, ranges, a marker)."""
+    if not isinstance(overlay, hv.Overlay):
+        return None
+    return tuple((type(el), key, el.id, tuple((d.name, d.label, d.unit) for d in el.dimensions()))
+                 for key, el in overlay.data.items())
+
+
+def same_shape(old, new) -> bool:
+    """Whether overlays ``old`` and ``new`` differ in their numbers only (:func:`_shape`)."""
+    shape = _shape(old)
+    return shape is not None and shape == _shape(new)
+
+
 def reuse_unchanged(old: hv.Overlay | hv.Element | None, new: hv.Overlay | hv.Element):
     """``new``, with every element whose data equal the element at the same place in ``old``
     replaced by that old element (so that HoloViews sends none of its data again)."""
@@ -138,7 +154,30 @@ class LivePlot:
         overlays = list(overlays)
         if len(overlays) != len(self.pipe.data):
             raise ValueError(f"{len(overlays)} overlays for {len(self.pipe.data)} plots")
-        self.pipe.send([reuse_unchanged(old, new) for old, new in zip(self.pipe.data, overlays)])
+        frames = [reuse_unchanged(old, new) for old, new in zip(self.pipe.data, overlays)]
+        if self._write(frames):
+            self.pipe.update(data=frames)  # silently: the DynamicMaps read it when next evaluated
+        else:
+            self.pipe.send(frames)
+
+    def _write(self, frames: list) -> bool:
+        """Write ``frames`` straight into the Bokeh models of the shown plots if each differs from
+        the frame shown in its numbers only (:func:`app.patches.write_frame`); False, with nothing
+        written, if any plot must be updated by HoloViews (a new shape, or a plot not yet shown)."""
+        pairs = []
+        for pane, old, new in zip(self.panes, self.pipe.data, frames):
+            if new is old:
+                continue
+            plots = patches.holoviews_plots(pane)
+            if not plots or not same_shape(old, new):
+                return False
+            pairs += [(plot, old, new) for plot in plots]
+        checked = [patches.written(plot, old, new) for plot, old, new in pairs]
+        if not all(checked):
+            return False
+        for write in checked:
+            write()
+        return True
 
 
 @contextlib.contextmanager

@@ -232,3 +232,72 @@ def test_hostile_values_from_the_page_leave_a_message_or_nothing(app, caplog):
     app.measured.stiffness_file.value = {"empty.csv": ""}  # an empty file: its own message, not the last one
     assert app.state.data_message.startswith("empty.csv: ") and "empty" in app.state.data_message
     assert not [r for r in caplog.records if r.exc_info]
+
+
+def _shown_numbers(live) -> list:
+    """Every number the Bokeh models of a LivePlot show: each plot's axis ranges, each element's
+    data-source columns and each marker's position, in the overlays' order."""
+    from app.patches import holoviews_plots
+
+    out = []
+    for pane, overlay in zip(live.panes, live.current):
+        (plot,) = holoviews_plots(pane)
+        out.append((plot.handles["x_range"].start, plot.handles["x_range"].end,
+                    plot.handles["y_range"].start, plot.handles["y_range"].end))
+        for key in overlay.data:
+            handles = plot.subplots[key].handles
+            if hasattr(handles.get("glyph"), "location"):
+                out.append(handles["glyph"].location)
+            else:
+                out.append({k: np.asarray(v) for k, v in handles["source"].data.items()})
+    return out
+
+
+def _same_numbers(a, b) -> bool:
+    if len(a) != len(b):
+        return False
+    for x, y in zip(a, b):
+        if isinstance(x, dict):
+            if set(x) != set(y) or not all(np.array_equal(x[k], y[k], equal_nan=True) for k in x):
+                return False
+        elif not np.allclose(x, y, rtol=1e-12, atol=0):
+            return False
+    return True
+
+
+def test_a_change_of_numbers_shows_what_holoviews_draws_for_the_same_frames():
+    """app.patches.written: frames that differ in their numbers only are written into the Bokeh
+    models HoloViews made (HoloViews not asked); the plots then show exactly what HoloViews itself
+    draws for those frames from scratch. A frame of another shape (a reference pinned) goes to
+    HoloViews."""
+    from bokeh.document import Document
+
+    from app import curves, plots
+    from app.live import LivePlot
+    from app.patches import holoviews_plots
+
+    def frames(amplitude, frequency_hz, design=PAPER_B, **kwargs):
+        o = plots.explorer_overlays(curves.explorer_data(design, frequency_hz, amplitude, **kwargs))
+        return [o["loop"], *(o[k] for k in plots.TITLES)]
+
+    def drawn(overlays):
+        live = LivePlot(overlays)
+        doc = Document()
+        for pane in live.panes:
+            pane.get_root(doc)
+        return live
+
+    live = drawn(frames(0.1, 10.0))
+    assert all(len(holoviews_plots(p)) == 1 for p in live.panes)  # Panel's private HoloViews._plots
+    asked = []
+    live.pipe.add_subscriber(lambda **_kw: asked.append(1))
+    stiffer = PAPER_B.replace(shear_modulus=1.3 * PAPER_B.material.shear_modulus, length=0.9 * PAPER_B.geometry.length)
+    later = frames(0.05, 20.0, stiffer)  # every number changes: design, amplitude, frequency
+    live.show(later)
+    assert asked == []  # written, not sent through HoloViews
+    assert _same_numbers(_shown_numbers(live), _shown_numbers(drawn(later)))
+    assert not _same_numbers(_shown_numbers(live), _shown_numbers(drawn(frames(0.1, 10.0))))
+    pinned = frames(0.05, 20.0, stiffer, reference=PAPER_B)
+    live.show(pinned)
+    assert asked == [1]  # a new shape: HoloViews builds it
+    assert _same_numbers(_shown_numbers(live), _shown_numbers(drawn(pinned)))
