@@ -1,5 +1,5 @@
 """State of the "Find the missing effect" tab: the data, the baseline, the diagnosis and its
-plots' data. No Panel import: the view (:mod:`app.diagnosis`) is thin."""
+plots' data. No Panel import: the view (:mod:`app.tabs.find_the_missing_effect`) is thin."""
 
 from __future__ import annotations
 

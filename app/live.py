@@ -18,7 +18,7 @@ Three costs that were measured here and are avoided (explorer, Chromium, this ma
   (:func:`app.patches.frozen_models`) the plots' own freezes walk nothing, and the outer one
   walks only if the change added or removed models; one ``hold`` sends every change in one
   message.
-* **No WebGL** (:func:`app.elements.canvas`, a hook of every plot).
+* **No WebGL** (:func:`app.plotting.style.canvas`, a hook of every plot).
 """
 
 from __future__ import annotations
@@ -162,7 +162,7 @@ class LivePlot:
 
     def _write(self, frames: list) -> bool:
         """Write ``frames`` straight into the Bokeh models of the shown plots if each differs from
-        the frame shown in its numbers only (:func:`app.patches.write_frame`); False, with nothing
+        the frame shown in its numbers only (:func:`app.patches.written`); False, with nothing
         written, if any plot must be updated by HoloViews (a new shape, or a plot not yet shown)."""
         pairs = []
         for pane, old, new in zip(self.panes, self.pipe.data, frames):

@@ -42,7 +42,7 @@ list ``value``: every typed or dragged number is processed at once. That is 50 m
 by construction, and it is also correct behaviour: with the debounce, a click right after typing
 (the design form's "Find designs") was processed before the typed value, on the old one.
 
-**Data-only updates** (:func:`holoviews_plots`, :func:`write_frame`). HoloViews builds each plot
+**Data-only updates** (:func:`holoviews_plots`, :func:`written`). HoloViews builds each plot
 (its dimensions, styles, legend, linked axes, tap stream); a later frame with the same elements
 (kinds, labels, styles, dimensions) differs only in its numbers, and those are written into the
 Bokeh models HoloViews made: each changed element's columns (HoloViews' own ``get_data`` makes

@@ -7,8 +7,8 @@ import numpy as np
 import panel as pn
 import param
 
-from .elements import dimensions
 from .live import update_or_keep
+from .plotting.style import dimensions
 from .state import ExplorerState
 from .units import OPERATING_FREQUENCIES
 
@@ -27,8 +27,8 @@ class PlotView(pn.viewable.Viewer):
         super().__init__(state=state, **params)
 
     def dims_for(self, mode: str) -> dict:
-        """The view's dimensions (:func:`app.elements.dimensions`): kept while the mode is, new with
-        new units; never changed (each update puts its ranges on clones, :func:`app.elements.ranged`)."""
+        """The view's dimensions (:func:`app.plotting.style.dimensions`): kept while the mode is, new with
+        new units; never changed (each update puts its ranges on clones, :func:`app.plotting.style.ranged`)."""
         if mode != self._mode:
             self.dims, self._mode = dimensions(mode), mode
         return self.dims

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from app.bands import parse_tolerances
-from app.share import URL_NAMES
+from app.link import URL_NAMES
 from app.state import ExplorerState
 from core import Design, Geometry, Material
 from core.whatif.tolerance import ToleranceError

@@ -83,8 +83,8 @@ def test_only_changed_data_are_sent(app):
 def test_unchanged_elements_are_kept_as_they_were():
     import holoviews as hv
 
-    from app.elements import curve
     from app.live import reuse_unchanged
+    from app.plotting.style import curve
 
     x, y = hv.Dimension("x"), hv.Dimension("y")
     a = curve([1.0, np.nan], [2.0, 3.0], x, y, "a")
@@ -195,7 +195,7 @@ def test_changes_add_no_styles_and_no_options_entries(app):
     entry to HoloViews' options store (a session's memory stays flat however long it runs)."""
     import holoviews as hv
 
-    from app import elements
+    from app.plotting import style as elements
 
     app.state.shear_modulus_mpa = 2.5  # every style in use once
     app.state.amplitude = 0.3
@@ -272,9 +272,10 @@ def test_a_change_of_numbers_shows_what_holoviews_draws_for_the_same_frames():
     HoloViews."""
     from bokeh.document import Document
 
-    from app import curves, plots
+    from app import curves
     from app.live import LivePlot
     from app.patches import holoviews_plots
+    from app.plotting import explorer as plots
 
     def frames(amplitude, frequency_hz, design=PAPER_B, **kwargs):
         o = plots.explorer_overlays(curves.explorer_data(design, frequency_hz, amplitude, **kwargs))

@@ -183,8 +183,8 @@ def test_grid_amplitudes_follow_the_equivalent_strain():
 
 
 def test_the_explorers_export_panel_writes_every_tool_format():
+    from app.export import TOOL_FORMATS
     from app.main import App
-    from app.share import TOOL_FORMATS
 
     app = App()
     app.state.amplitude = 0.2  # mm

@@ -7,6 +7,7 @@ from bokeh.models import Plot
 from numpy.testing import assert_allclose
 
 from app import plots
+from app.plotting import explorer, fletcher_gent
 from core import PAPER_B, TABLE_1, stiffness, stiffness_points
 from core.synthetic import paper_b_example
 from tests.helpers import marker_at, xy
@@ -89,12 +90,12 @@ def test_a_plot_keeps_its_axes_when_the_same_dimensions_draw_another_design():
     dims = plots.dimensions("axial")
     given = [(d.name, tuple(d.range)) for d in dims.values()]
     stiff = PAPER_B.replace(shear_modulus=100 * PAPER_B.material.shear_modulus)
-    first = plots.explorer_overlays(curves.explorer_data(PAPER_B, 10.0, 0.1), dims)
-    shape = plots.loop_shape_overlay(curves.hysteresis_loop(PAPER_B, 10.0, 0.1), dims)
+    first = explorer.explorer_overlays(curves.explorer_data(PAPER_B, 10.0, 0.1), dims)
+    shape = fletcher_gent.loop_shape_overlay(curves.hysteresis_loop(PAPER_B, 10.0, 0.1), dims)
     before = {k: axes(ov) for k, ov in first.items()}
     k_f = first[("magnitude", "frequency")]
     assert k_f.get(0).vdims[0].range[1] < 1e3  # |K| in kN/mm: PAPER_B's
-    second = plots.explorer_overlays(curves.explorer_data(stiff, 50.0, 0.5, freq_range=(100.0, 200.0)), dims)
+    second = explorer.explorer_overlays(curves.explorer_data(stiff, 50.0, 0.5, freq_range=(100.0, 200.0)), dims)
     assert second[("magnitude", "frequency")].get(0).vdims[0].range[0] > k_f.get(0).vdims[0].range[1]
     assert {k: axes(ov) for k, ov in first.items()} == before
     assert [(d.name, tuple(d.range)) for d in dims.values()] == given
@@ -114,7 +115,7 @@ def snapshot():
     return (sorted((k, repr(v)) for k, v in r.param.values().items()), hv.Store.current_backend,
             sorted(hv.Store.options().keys()), len(hv.Store.custom_options()))
 before = snapshot()
-import app.plots, app.elements
+import app.plots, app.plotting.style
 print(before == snapshot(), hv.renderer("bokeh").webgl)
 """
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
@@ -140,10 +141,10 @@ def test_the_explorer_s_plots_leave_the_sweep_curves_they_are_given_as_they_were
 
     dims = plots.dimensions("axial")
     data = curves.explorer_data(PAPER_B, 10.0, 0.1)
-    labels = plots.explorer_labels(data)
-    given = {k: plots.sweep_curves(*k, data.sweeps[k[1]], dims, labels[k[1]]) for k in plots.TITLES}
+    labels = explorer.explorer_labels(data)
+    given = {k: explorer.sweep_curves(*k, data.sweeps[k[1]], dims, labels[k[1]]) for k in explorer.TITLES}
     kept = {k: list(v) for k, v in given.items()}
-    out = plots.explorer_overlays(data, dims, given)
+    out = explorer.explorer_overlays(data, dims, given)
     assert set(given) == set(kept) and all(given[k][i] is kept[k][i] for k in kept for i in range(len(kept[k])))
     drawn = out[("magnitude", "frequency")].get(0)
     assert tuple(drawn.vdims[0].range) == tuple(data.ranges["magnitude"])

@@ -7,12 +7,12 @@ import numpy as np
 import panel as pn
 import param
 
-from . import plots
-from .curves import padded
-from .elements import ranged
-from .live import LivePlot, update_or_keep
-from .state import ExplorerState
-from .views import PlotView
+from ..curves import padded
+from ..live import LivePlot, update_or_keep
+from ..plotting.fletcher_gent import branch_overlays, loop_shape_overlay
+from ..plotting.style import ranged
+from ..state import ExplorerState
+from ..views import PlotView
 
 TEACHING_TEXT = """
 **Why filled rubber softens and dissipates more as the amplitude grows.** The stress is the sum of
@@ -61,7 +61,7 @@ class TeachingView(PlotView):
         dims = ranged(self.dims_for(self.state.design.mode), {
             "amplitude": padded([d["amplitude"]], log=True), "real": padded([np.zeros(1), totals["real"]]),
             "branch_loss": padded([np.zeros(1), totals["loss"]])})
-        overlays = plots.branch_overlays(d, dims, self.state.amplitude)
+        overlays = branch_overlays(d, dims, self.state.amplitude)
         items = [overlays[w] for w in WHICH]
         self.branches = LivePlot.shown(self.branches, items, taps={0: self.tap_amplitude, 1: self.tap_amplitude})
         self._draw_frame()
@@ -71,7 +71,7 @@ class TeachingView(PlotView):
 
     def _draw_frame(self):
         x = np.geomspace(*self.state.amplitude_bounds, self.FRAMES)[self.player.value]
-        shape = plots.loop_shape_overlay(self.state.hysteresis_loop(amplitude=x), self.dims)
+        shape = loop_shape_overlay(self.state.hysteresis_loop(amplitude=x), self.dims)
         self.loop = LivePlot.shown(self.loop, [shape])
         self.frame_label.object = (f'<span class="frame-point">Loop shape at <b>{x:.3g} '
                                    f"{self.state.amplitude_unit}</b>, {self.state.frequency_hz:.3g} Hz</span>")

@@ -14,12 +14,12 @@ from core.effects import EFFECTS
 from core.identify.diagnose import BIC_THRESHOLD
 from core.material import ConvergenceError
 
-from .diagnosis_state import DiagnosisState
-from .elements import SWEEP_PALETTES, sweep_label
-from .live import LivePlot, update_or_keep
-from .misfit_plots import diagnosis_overlays
-from .units import amplitude_unit
-from .uploads import csv_dropper, on_upload
+from ..diagnosis_state import DiagnosisState
+from ..live import LivePlot, update_or_keep
+from ..plotting.find_the_missing_effect import diagnosis_overlays
+from ..plotting.style import SWEEP_PALETTES, sweep_label
+from ..units import amplitude_unit
+from ..uploads import csv_dropper, on_upload
 
 log = logging.getLogger("bushing.app")
 

@@ -11,15 +11,16 @@ from core.card import card, card_design, ratios
 from core.parameters import MODE, ROTATIONS, TRANSLATIONS
 from core.shape import long_shape_factor
 
-from . import plots, units
-from .bands import BAND_PARAMETERS
-from .curves import card_bands, card_sweeps, padded
-from .elements import ranged
-from .inputs import FloatInput
-from .live import LivePlot
-from .state import ExplorerState
-from .units import ROTATION, TRANSLATION
-from .views import PlotView
+from .. import units
+from ..bands import BAND_PARAMETERS
+from ..curves import card_bands, card_sweeps, padded
+from ..inputs import FloatInput
+from ..live import LivePlot
+from ..plotting.every_direction import card_dimensions, card_overlays
+from ..plotting.style import ranged
+from ..state import ExplorerState
+from ..units import ROTATION, TRANSLATION
+from ..views import PlotView
 
 WHICH = ("translation", "translation_loss", "rotation", "rotation_loss")
 TEXT = """
@@ -46,7 +47,7 @@ class CardView(PlotView):
             FloatInput.from_param(self.param.angle_rad, start=1e-7, end=1.0, step=0.001),
             sizing_mode="stretch_width")
         self.table = pn.pane.Markdown("", sizing_mode="stretch_width")
-        self.dims = plots.card_dimensions()
+        self.dims = card_dimensions()
         self.plots: LivePlot | None = None
         self._update()
 
@@ -74,7 +75,7 @@ class CardView(PlotView):
         dims = ranged(self.dims, {axis: padded([data[m]["amplitude"] for m in modes], log=True)
                                   for axis, modes in (("displacement", TRANSLATIONS), ("angle", ROTATIONS))})
         at = {"translation": TRANSLATION.amplitude.to_display(x), "rotation": ROTATION.amplitude.to_display(angle)}
-        overlays = plots.card_overlays(data, dims, at)
+        overlays = card_overlays(data, dims, at)
         self.plots = LivePlot.shown(self.plots, [overlays[w] for w in WHICH])
 
     @staticmethod

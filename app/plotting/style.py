@@ -4,7 +4,7 @@ points, areas, markers and overlays, each a clone of a styled template.
 Each element is a clone of a styled template (:func:`styled`): the options are attached once,
 and a clone carries them, so a live plot that rebuilds its elements on every change does not
 re-resolve its options. The figures are built from them in :mod:`app.plots` (the public
-plotting API) and :mod:`app.misfit_plots` (model against measured data).
+plotting API) and :mod:`app.plotting.measured_data_and_fit` (model against measured data).
 """
 
 from __future__ import annotations
@@ -30,6 +30,13 @@ SWEEP_PALETTES = {  # light to dark as the swept value grows
 
 def sweep_label(value, unit) -> str:
     return f"{value:.3g} {unit}"
+
+
+BRANCH_COLORS = {"elastic": "#1f77b4", "viscoelastic": "#2ca02c", "friction": "#d62728"}
+
+REFERENCE_STYLE = {"color": "#444444", "line_dash": "dashed", "line_width": 2}
+
+MEASURED_STYLE = {"color": "#222222", "alpha": 0.6, "size": 5}
 
 
 # ---- dimensions --------------------------------------------------------------------------------

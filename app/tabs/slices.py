@@ -6,12 +6,12 @@ import numpy as np
 import panel as pn
 import param
 
-from . import plots
-from .curves import padded
-from .elements import ranged
-from .live import LivePlot
-from .state import ExplorerState
-from .views import PlotView
+from ..curves import padded
+from ..live import LivePlot
+from ..plotting.slices import SLICE_NAMES, slices_overlays
+from ..plotting.style import ranged
+from ..state import ExplorerState
+from ..views import PlotView
 
 WHICH = ("magnitude", "magnitude_diff_pct", "loss_factor")
 
@@ -19,7 +19,7 @@ WHICH = ("magnitude", "magnitude_diff_pct", "loss_factor")
 class SlicesView(PlotView):
     """One equivalent modulus against 2 and 3 slices and the continuum, at the loop frequency."""
 
-    NAMES = plots.SLICE_NAMES
+    NAMES = SLICE_NAMES
 
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
@@ -37,7 +37,7 @@ class SlicesView(PlotView):
     def _update(self):
         data = self.state.slice_comparison()
         dims = ranged(self.dims_for(self.state.design.mode), {"amplitude": padded([data["amplitude"]], log=True)})
-        overlays = plots.slices_overlays(data, dims, self.state.amplitude)
+        overlays = slices_overlays(data, dims, self.state.amplitude)
         items = [overlays[w] for w in WHICH]
         self.plots = LivePlot.shown(self.plots, items, taps={i: self.tap_amplitude for i in range(len(WHICH))})
         self.table.object = self.summary(data)

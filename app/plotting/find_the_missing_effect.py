@@ -1,6 +1,5 @@
-"""Model against measured data, as HoloViews elements: the residuals at every measured point, a
-fit's predicted rows, and a diagnosis (:mod:`core.identify.diagnose`) step by step. The design
-functions of :mod:`app.plots` lay them out; the measured-data and diagnosis tabs draw them live.
+"""The Find the missing effect tab's plots: a diagnosis (:mod:`core.identify.diagnose`) step by
+step, the curves of the data and both models, the misfit maps before and after.
 """
 
 from __future__ import annotations
@@ -8,39 +7,20 @@ from __future__ import annotations
 import holoviews as hv
 import numpy as np
 
-from core.parameters import MODES
-
-from . import curves
-from .elements import (
-    MODE_COLORS,
-    OPERATING_COLOR,
+from .. import curves
+from .style import (
     SWEEP_PALETTES,
     curve,
     dimensions,
     overlay,
     ranged,
     scatter,
+    sized,
     styled,
     sweep_label,
 )
 
-
-def residual_overlays(points: dict | None, residuals: dict | None, dims: dict) -> dict:
-    """Model − measured at every measured point: |K| in % and the loss factor, against
-    frequency and amplitude (``points`` from :func:`app.curves.measured_points`, ``residuals`` as
-    :meth:`app.state.ExplorerState.measured_residuals`)."""
-    out = {}
-    for against in ("frequency", "amplitude"):
-        x = [] if points is None else points["frequency_hz" if against == "frequency" else "amplitude"]
-        for quantity, ydim, column in (("magnitude", dims["residual_magnitude"], "magnitude_residual_pct"),
-                                       ("loss", dims["residual_loss"], "loss_factor_residual")):
-            y = [] if residuals is None else residuals[column]
-            title = f"{ydim.label}, model − measured, against {against}"
-            out[(quantity, against)] = overlay(
-                [scatter(x, y, dims[against], ydim, "residual", color=OPERATING_COLOR, alpha=0.7, size=6)],
-                title, f"bushing-residual-{quantity}-vs-{against}", logx=against == "amplitude", legend=None,
-                height=240)
-    return out
+MISFIT_PNG = {"magnitude_pct": "magnitude", "loss_factor": "loss"}
 
 
 def gap_bars(stages: dict, dims: dict) -> hv.Overlay:
@@ -53,7 +33,6 @@ def gap_bars(stages: dict, dims: dict) -> hv.Overlay:
                             color="#d62728", line_dash="dashed", line_width=2))
     return overlay(items, "Gap (relative RMS misfit of complex stiffness) after each step", "bushing-diagnosis-gap",
                    legend=None, height=230)
-
 
 def diagnosis_curves(groups: list, dims: dict) -> dict:
     """Data (points) against the baseline (dashed) and the final model (solid), one colour per
@@ -76,10 +55,6 @@ def diagnosis_curves(groups: list, dims: dict) -> dict:
                                 f"bushing-diagnosis-{quantity}", legend=None, height=280)
     return out
 
-
-MISFIT_PNG = {"magnitude_pct": "magnitude", "loss_factor": "loss"}
-
-
 def misfit_map(m: dict, column: str, title: str, dims: dict, limit: float, png: str) -> hv.Overlay:
     """A misfit over the (frequency, amplitude) plane: one square per measured point, coloured
     on a diverging scale from −``limit`` to +``limit`` (red: model above the data)."""
@@ -90,7 +65,6 @@ def misfit_map(m: dict, column: str, title: str, dims: dict, limit: float, png: 
                  marker="square", size=11, colorbar=True, line_color="#777777", line_width=0.5,
                  clim=(-limit, limit), tools=["hover"])
     return overlay([pts], title, png, logy=True, legend=None, height=260)
-
 
 def diagnosis_overlays(diagnosis) -> dict:
     """The plots of a :class:`core.identify.diagnose.Diagnosis`: ``"gap"`` (one plot: the gap after each
@@ -114,18 +88,23 @@ def diagnosis_overlays(diagnosis) -> dict:
     return {"gap": [gap_bars(stages, dims)], "curves": list(diagnosis_curves(groups, dims).values()),
             "maps": maps, "groups": groups}
 
+def diagnosis_plots(diagnosis, *, width: int | None = 560) -> hv.Layout:
+    """The plots of a diagnosis: the gap after each step, the curves, the misfit maps.
 
-def prediction_overlay(data: dict) -> hv.Overlay:
-    """A fit on a subset predicting the rest (:func:`app.curves.prediction_misfit`): the |K|
-    misfit of every mode against frequency, fitted rows filled, predicted rows hollow."""
-    xdim = dimensions(MODES[0])["frequency"]  # the same in every mode
-    ydim = hv.Dimension("prediction_misfit", label="|K|, model − measured", unit="%")
-    items = []
-    for mode, parts in data.items():
-        color = MODE_COLORS.get(mode, OPERATING_COLOR)
-        for which, fill in (("fitted", 0.8), ("predicted", 0.0)):
-            part = parts[which]
-            if len(part["frequency_hz"]):
-                items.append(scatter(part["frequency_hz"], part["misfit_pct"], xdim, ydim,
-                                     f"{mode}, {which}", color=color, fill_alpha=fill, line_color=color, size=6))
-    return overlay(items, "Fitted and predicted rows, every mode: |K| misfit", "bushing-prediction", height=300)
+    Parameters
+    ----------
+    diagnosis : Diagnosis
+        A :class:`core.identify.diagnose.Diagnosis` (SI inside).
+    width : int or None, default 560
+        The width of each plot in pixels; None: as wide as its container.
+
+    Returns
+    -------
+    holoviews.Layout
+        In two columns: the gap after each step (dimensionless); |K| (kN/mm or N·m/rad) and the
+        loss factor (dimensionless) of the data, the baseline and the final model; the misfit
+        maps before and after (|K| in %, the loss factor dimensionless) over frequency (Hz) and
+        amplitude (mm or rad).
+    """
+    overlays = diagnosis_overlays(diagnosis)
+    return sized(hv.Layout(overlays["gap"] + overlays["curves"] + overlays["maps"]).cols(2), width)

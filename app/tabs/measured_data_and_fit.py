@@ -15,13 +15,14 @@ from core import PAPER_B
 from core.parameters import BY_NAME, MATERIAL
 from core.synthetic import paper_b_example
 
-from . import curves, misfit_plots
-from .curves import padded
-from .elements import ranged
-from .live import LivePlot
-from .state import ExplorerState
-from .uploads import csv_dropper, on_files, on_upload
-from .views import PlotView
+from .. import curves
+from ..curves import padded
+from ..live import LivePlot
+from ..plotting.measured_data_and_fit import prediction_overlay, residual_overlays
+from ..plotting.style import ranged
+from ..state import ExplorerState
+from ..uploads import csv_dropper, on_files, on_upload
+from ..views import PlotView
 
 RESIDUALS = (("magnitude", "frequency"), ("loss", "frequency"), ("magnitude", "amplitude"), ("loss", "amplitude"))
 
@@ -134,14 +135,14 @@ class MeasuredView(PlotView):
             self._prediction_key = key
             data = curves.prediction_misfit(r, s.measured)
             self.prediction.visible = data is not None
-            self.prediction.object = None if data is None else misfit_plots.prediction_overlay(data)
+            self.prediction.object = None if data is None else prediction_overlay(data)
 
     def _draw(self, points, residuals):
         dims = self.dims_for(self.state.design.mode)
         if points is not None:  # plots of the same quantity share the axis: one range (one clone) for both
             dims = ranged(dims, {"residual_magnitude": padded([residuals["magnitude_residual_pct"]]),
                                  "residual_loss": padded([residuals["loss_factor_residual"]])})
-        overlays = misfit_plots.residual_overlays(points, residuals, dims)
+        overlays = residual_overlays(points, residuals, dims)
         items = [overlays[k] for k in RESIDUALS]
         self.residuals = LivePlot.shown(self.residuals, items)
 

@@ -18,11 +18,12 @@ from core.whatif.sensitivity import elasticities, ranked, sentence
 from core.whatif.target import Found, TargetError, solve
 from core.whatif.tolerance import ToleranceError
 
-from . import plots, units
-from .inputs import FloatInput, IntInput
-from .live import LivePlot
-from .state import ExplorerState
-from .views import PlotView
+from .. import units
+from ..inputs import FloatInput, IntInput
+from ..live import LivePlot
+from ..plotting.what_ifs import sensitivity_bars
+from ..state import ExplorerState
+from ..views import PlotView
 
 log = logging.getLogger("bushing.app")
 
@@ -166,7 +167,7 @@ class WhatIfView(PlotView):
                            vdims=[hv.Dimension(f"sensitivity_{quantity}", label=label)])
             title = "|K|: % per +1 % of the parameter" if quantity == "magnitude" else \
                 "Loss factor: change per unit ln p"
-            items.append(plots.sensitivity_bars(bars, title, color, f"bushing-sensitivity-{quantity.replace('_', '-')}"))
+            items.append(sensitivity_bars(bars, title, color, f"bushing-sensitivity-{quantity.replace('_', '-')}"))
         self.bars = LivePlot.shown(self.bars, items)
         s = self.state
         self.sentence.object = (f"At {s.frequency_hz:.3g} Hz and {s.amplitude:.3g} {s.amplitude_unit}: "

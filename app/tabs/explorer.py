@@ -8,12 +8,12 @@ import holoviews as hv
 import panel as pn
 import param
 
-from . import plots
-from .bands import BAND_PARAMETERS
-from .elements import ranged
-from .live import LivePlot
-from .state import ExplorerState
-from .views import PlotView
+from ..bands import BAND_PARAMETERS
+from ..live import LivePlot
+from ..plotting.explorer import explorer_labels, explorer_overlays, on_ranges, sweep_curves
+from ..plotting.style import ranged
+from ..state import ExplorerState
+from ..views import PlotView
 
 GRID = (("magnitude", "frequency"), ("magnitude", "amplitude"), ("loss_factor", "frequency"),
         ("loss_factor", "amplitude"))
@@ -48,13 +48,13 @@ class ExplorerPlots(PlotView):
         self.dims_for(data.mode)  # new units: new axes
         key = (s.design, s.freq_range)
         if key != self._sweeps_key:  # the sweeps change with the design, not the operating point
-            labels = plots.explorer_labels(data)
-            self._sweeps = {k: plots.sweep_curves(*k, data.sweeps[k[1]], self.dims, labels[k[1]]) for k in GRID}
+            labels = explorer_labels(data)
+            self._sweeps = {k: sweep_curves(*k, data.sweeps[k[1]], self.dims, labels[k[1]]) for k in GRID}
             self._sweeps_key = key
         dims = ranged(self.dims, data.ranges)
         # the kept sweeps on this update's ranges, kept so: re-ranged once per change of ranges
-        self._sweeps = {k: plots.on_ranges(items, dims, *k) for k, items in self._sweeps.items()}
-        overlays = plots.explorer_overlays(data, dims, self._sweeps)
+        self._sweeps = {k: on_ranges(items, dims, *k) for k, items in self._sweeps.items()}
+        overlays = explorer_overlays(data, dims, self._sweeps)
         grid = [overlays[k] for k in GRID]
         if self.grid is None:
             taps = {i: self.tap_frequency if against == "frequency" else self.tap_amplitude

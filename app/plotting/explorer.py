@@ -1,0 +1,166 @@
+"""The Explorer tab's plots: the hysteresis loop at the operating point, and |K| and the loss
+factor against frequency and amplitude (the sweeps, the operating curve, a reference, measured
+points, a tolerance band, the operating point's marker).
+"""
+
+from __future__ import annotations
+
+import holoviews as hv
+
+from core import Design
+
+from .. import curves
+from .style import (
+    BRANCH_COLORS,
+    MEASURED_STYLE,
+    OPERATING_COLOR,
+    REFERENCE_STYLE,
+    SWEEP_PALETTES,
+    band_area,
+    band_label,
+    curve,
+    dimensions,
+    marker,
+    overlay,
+    ranged,
+    scatter,
+    sized,
+    sweep_label,
+)
+
+TITLES = {
+    ("magnitude", "frequency"): "|K| against frequency",
+    ("loss_factor", "frequency"): "Loss factor against frequency",
+    ("magnitude", "amplitude"): "|K| against amplitude",
+    ("loss_factor", "amplitude"): "Loss factor against amplitude",
+}
+
+LOOP_TITLE = "Hysteresis loop at the operating point"
+
+def strain_label(ratio: float) -> str:
+    """The legend of a frequency sweep: its equivalent strain as a multiple of ε½ (the same for
+    every design, so a legend never changes while the design does)."""
+    return "ε̂ = ε½" if ratio == 1 else f"ε̂ = {ratio:g} ε½"
+
+def loop_overlay(lp: dict, dims: dict, *, reference: dict | None = None, measured: dict | None = None,
+                 title: str = LOOP_TITLE) -> hv.Overlay:
+    """The hysteresis loop (:func:`app.curves.hysteresis_loop`) branch by branch, a reference
+    loop (dashed) and measured points, on ``dims`` (:func:`dimensions`)."""
+    x, f = dims["displacement"], dims["force"]
+    items = [curve(lp["displacement"], lp[f"force_{name}"], x, f, name, color=color, line_width=1.5)
+             for name, color in BRANCH_COLORS.items()]
+    if reference is not None:
+        items.append(curve(reference["displacement"], reference["force"], x, f, "reference", **REFERENCE_STYLE))
+    items.append(curve(lp["displacement"], lp["force"], x, f, "total", color="black", line_width=2.5))
+    if measured is not None:
+        items.append(scatter(measured["displacement"], measured["force"], x, f, "measured", color="#222222",
+                             alpha=0.5, size=4))
+    return overlay(items, title, "bushing-hysteresis-loop", legend="top_left", height=330)
+
+def sweep_curves(quantity: str, against: str, sweep: dict, dims: dict, labels) -> list:
+    """One curve per swept value: |K| or the loss factor against frequency (a row per
+    amplitude) or against amplitude (a row per frequency)."""
+    x = sweep["frequency_hz"] if against == "frequency" else sweep["amplitude"]
+    palette = SWEEP_PALETTES["amplitude" if against == "frequency" else "frequency"]
+    return [curve(x, row, dims[against], dims[quantity], label, color=palette[i % len(palette)], line_width=1.3)
+            for i, (row, label) in enumerate(zip(sweep[quantity], labels))]
+
+def sweep_overlay(quantity: str, against: str, sweep_items: list, dims: dict, *, operating: dict,
+                  at: float, reference: dict | None = None, measured: dict | None = None,
+                  band: tuple | None = None, band_name: str = "") -> hv.Overlay:
+    """|K| or the loss factor against ``against`` ("frequency" or "amplitude"): the sweeps
+    (:func:`sweep_curves`), the tolerance band of the operating curve (``band``: low, high), the
+    curve through the operating point (``operating``, a one-row sweep), a reference design's
+    (dashed), measured points and the marker at ``at``."""
+    xdim, ydim = dims[against], dims[quantity]
+    x_of = (lambda s: s["frequency_hz"]) if against == "frequency" else (lambda s: s["amplitude"])
+    items = list(sweep_items)
+    if band is not None:
+        items.append(band_area(x_of(operating), *band, xdim, ydim, band_name, OPERATING_COLOR))
+    if reference is not None:
+        items.append(curve(x_of(reference), reference[quantity][0], xdim, ydim, "reference", **REFERENCE_STYLE))
+    items.append(curve(x_of(operating), operating[quantity][0], xdim, ydim, "operating point",
+                       color=OPERATING_COLOR, line_width=3))
+    if measured is not None:
+        items.append(scatter(x_of(measured), measured[quantity], xdim, ydim, "measured", **MEASURED_STYLE))
+    items.append(marker(at, xdim))
+    return overlay(items, TITLES[(quantity, against)], f"bushing-{quantity}-vs-{against}",
+                   logx=against == "amplitude")
+
+def explorer_labels(data: curves.ExplorerData) -> dict:
+    """The legend entries of the sweeps: equivalent strains against frequency, frequencies
+    against amplitude."""
+    return {"frequency": [strain_label(r) for r in curves.SWEEP_STRAINS],
+            "amplitude": [sweep_label(v, "Hz") for v in data.sweeps["amplitude"]["frequency_hz"]]}
+
+def on_ranges(items: list, dims: dict, quantity: str, against: str) -> list:
+    """A plot's sweep curves on the ranges of ``dims``: ``items`` themselves where they are on them,
+    else new curves of the same data. Every element of a plot carries its ranges: one without
+    would cost HoloViews a look at its data on every update (measured: about 5 ms per change)."""
+    if all(tuple(el.kdims[0].range) == tuple(dims[against].range)
+           and tuple(el.vdims[0].range) == tuple(dims[quantity].range) for el in items):
+        return items
+    return [el.clone(kdims=[dims[against]], vdims=[dims[quantity]]) for el in items]
+
+def explorer_overlays(data: curves.ExplorerData, dims: dict | None = None, sweep_items: dict | None = None) -> dict:
+    """The five plots of ``data`` (:func:`app.curves.explorer_data`): ``"loop"`` and one per (quantity,
+    against) of :data:`TITLES`. ``dims`` are the dimensions to draw on (a live view passes its
+    own, so that its plots keep their axes); the plots carry the data's ranges on clones of them
+    (:func:`app.plotting.style.ranged`), ``dims`` are left as they are. ``sweep_items`` may give the
+    sweep curves of each plot, already built (a live view keeps them while only the operating
+    point moves); those on other ranges are put on the plot's (new curves with the same data).
+    ``sweep_items`` itself is not changed (a live view keeps its own on the ranges,
+    :func:`on_ranges`)."""
+    dims = ranged(dims if dims is not None else dimensions(data.mode), data.ranges)
+    out = {"loop": loop_overlay(data.loop, dims, reference=data.reference_loop, measured=data.measured_loop)}
+    labels = explorer_labels(data)
+    for (quantity, against) in TITLES:
+        items = (sweep_items or {}).get((quantity, against))
+        if items is None:
+            items = sweep_curves(quantity, against, data.sweeps[against], dims, labels[against])
+        else:
+            items = on_ranges(items, dims, quantity, against)
+        out[(quantity, against)] = sweep_overlay(
+            quantity, against, items, dims, operating=data.operating[against],
+            at=data.frequency_hz if against == "frequency" else data.amplitude,
+            reference=data.references[against] if data.references else None, measured=data.measured,
+            band=data.bands[against][quantity] if data.bands else None,
+            band_name=band_label(data.bands["point"]["percentiles"]) if data.bands else "")
+    return out
+
+def explorer_plots(design: Design, frequency_hz: float = 10.0, amplitude: float | None = None, *,
+                   width: int | None = 600, **kwargs) -> hv.Layout:
+    """The explorer's five plots of ``design`` at an operating point.
+
+    The hysteresis loop, then |K| and the loss factor against frequency and against amplitude.
+    The design is SI (m, Pa); the plots and ``amplitude`` are in the display units of
+    :mod:`app.units`.
+
+    Parameters
+    ----------
+    design : Design
+        The bushing, in SI units.
+    frequency_hz : float, default 10.0
+        The operating frequency in Hz.
+    amplitude : float or None, default None
+        The operating amplitude in display units: mm (axial, radial) or rad (torsion,
+        conical); None: mid-way through the Fletcher–Gent range.
+    width : int or None, default 600
+        The width of each plot in pixels; None: as wide as its container.
+    **kwargs
+        As :func:`app.curves.explorer_data`: ``freq_range`` (Hz), ``reference`` (a Design),
+        ``measured`` (a MeasuredStiffness, SI: Hz, m or rad, N/m or N·m/rad), ``measured_loop``
+        (a MeasuredLoop, SI: s, m or rad, N or N·m), ``n_freq`` and ``n_amp`` (point counts),
+        ``bands`` (tolerance bands in display units).
+
+    Returns
+    -------
+    holoviews.Layout
+        Five plots in two columns: the loop (drive in mm or rad, force in N or N·m), and |K|
+        (kN/mm or N·m/rad) and the loss factor (dimensionless) against frequency (Hz) and
+        amplitude (mm or rad).
+    """
+    if amplitude is None:
+        amplitude = float(curves.fletcher_gent_amplitudes(design)[2])
+    overlays = explorer_overlays(curves.explorer_data(design, frequency_hz, amplitude, **kwargs))
+    return sized(hv.Layout([overlays["loop"], *(overlays[k] for k in TITLES)]).cols(2), width)
