@@ -152,6 +152,29 @@ def operating_point(design: Design, frequency_hz: float, amplitude: float) -> di
             "loss_factor": float(r.loss_factor[0, 0])}
 
 
+def comparison(design: Design, reference: Design | None, frequency_hz: float, amplitude: float,
+               freq_range=(1.0, 100.0), n: int = 120) -> dict | None:
+    """``design`` against a pinned ``reference`` (None: no comparison), in %: at the operating
+    point (``amplitude`` in display units) and the largest difference over the operating curves
+    against frequency (``n`` points over ``freq_range``) and against amplitude."""
+    if reference is None:
+        return None
+    f, x = np.linspace(*freq_range, n), amplitude_grid(design, n)
+    now, ref = operating_point(design, frequency_hz, amplitude), operating_point(reference, frequency_hz, amplitude)
+    fs_now, fs_ref = frequency_sweep(design, f, amplitude), frequency_sweep(reference, f, amplitude)
+    as_now, as_ref = amplitude_sweep(design, x, frequency_hz), amplitude_sweep(reference, x, frequency_hz)
+
+    def worst(a, b):
+        d = 100 * (a / b - 1)
+        return float(d.flat[np.argmax(np.abs(d))])
+
+    return {
+        "operating": {k: (now[k], ref[k], 100 * (now[k] / ref[k] - 1)) for k in ("magnitude", "loss_factor")},
+        "largest_over_frequency": {k: worst(fs_now[k], fs_ref[k]) for k in ("magnitude", "loss_factor")},
+        "largest_over_amplitude": {k: worst(as_now[k], as_ref[k]) for k in ("magnitude", "loss_factor")},
+    }
+
+
 PADDING = 0.1  # of the data's span (in log10 on a log axis), on both sides together
 
 

@@ -8,10 +8,13 @@ import io
 import numpy as np
 import panel as pn
 
+from core.bushing import stiffness
 from core.io.design_file import dumps_design
 from core.io.export import export
 from core.io.table import csv_text
+from core.whatif.tolerance import band, band_columns
 
+from .curves import amplitude_grid, fletcher_gent_amplitudes
 from .state import ExplorerState
 from .units import to_si_amplitude
 
@@ -53,7 +56,17 @@ class ExportView(pn.viewable.Viewer):
         return io.StringIO(dumps_design(self.state.design))
 
     def _table_csv(self):
-        return io.StringIO(csv_text(self.state.stiffness_table()))
+        return io.StringIO(csv_text(self.stiffness_table()))
+
+    def stiffness_table(self, n_freq: int = 25, n_amp: int = 25) -> dict:
+        """The docs/files.md stiffness table over the sweeps' frequency range and the
+        Fletcher–Gent amplitude range (SI units); with the tolerance bands on, their percentile
+        columns too (those of ``bushing stiffness --tolerance``)."""
+        s = self.state
+        f, x = np.linspace(*s.freq_range, n_freq), to_si_amplitude(amplitude_grid(s.design, n_amp), s.design.mode)
+        table = stiffness(s.design, f, x).table()
+        columns = s.banded(lambda tol: band_columns(band(s.design, f[None, :], np.asarray(x)[:, None], tol)))
+        return {**table, **(columns or {})}
 
     def tool_text(self, label: str) -> str:
         """The export ``label`` (:data:`TOOL_FORMATS`) of the current design."""
@@ -63,7 +76,7 @@ class ExportView(pn.viewable.Viewer):
         if fmt == "adams":
             return export(s.design, "adams", [s.frequency_hz], [x])
         freqs = np.geomspace(s.freq_min, s.freq_max, 30)
-        amps = [x, *(float(to_si_amplitude(a, s.design.mode)) for a in s.fletcher_gent_amplitudes(s.design))]
+        amps = [x, *(float(to_si_amplitude(a, s.design.mode)) for a in fletcher_gent_amplitudes(s.design))]
         return export(s.design, "table" if fmt.startswith("table") else fmt, freqs, amps, as_json=fmt == "table-json")
 
     def _tool_file(self):

@@ -11,9 +11,10 @@ from bokeh.models import CustomJSTickFormatter
 from core.bushing import STRUCTURAL_EFFECTS, shape_factor
 from core.parameters import DEFAULT_SHAPE
 
+from .curves import amplitude_bounds
 from .fields import DESIGN_FIELDS, GEOMETRY_FIELDS, MATERIAL_FIELDS
 from .state import ExplorerState
-from .units import OPERATING_FREQUENCIES
+from .units import OPERATING_FREQUENCIES, amplitude_unit
 
 
 class FloatInput(pn.widgets.FloatInput):
@@ -141,7 +142,8 @@ class DesignInputs(pn.viewable.Viewer):
                                            styles={"font-size": "0.9em"})
         state.param.watch(lambda *_e: self._shape_note(), ["design", "finite_length", "mode"])
         self._shape_note()
-        self.amplitude = LogSlider(state, "amplitude", lambda: state.amplitude_bounds, lambda: state.amplitude_unit)
+        self.amplitude = LogSlider(state, "amplitude", lambda: amplitude_bounds(state.design),
+                                   lambda: amplitude_unit(state.design.mode))
         self.frequency = LogSlider(state, "frequency_hz", lambda: OPERATING_FREQUENCIES, lambda: "Hz")
 
     def _field(self, name):

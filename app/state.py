@@ -15,12 +15,10 @@ import numpy as np
 import param
 
 from core import PAPER_B, TABLE_1, Design
-from core.bushing import stiffness
 from core.data import DataError, MeasuredLoop, MeasuredStiffness
 from core.identify.fit import FitResult, fit_global, fit_two_step, predicted, selection
 from core.io.measured import combined, parse_loop, parse_stiffness
 from core.parameters import MODE_TABLE, MODES
-from core.whatif.tolerance import band, band_columns
 
 from . import curves, units
 from .bands import ToleranceBands
@@ -159,7 +157,7 @@ class ExplorerState(DesignFields, ToleranceBands):
 
     def load_design(self, design: Design):
         """Show ``design`` (a preset, a file, a fit), its operating amplitude mid-range."""
-        x_mid = self.fletcher_gent_amplitudes(design)[2]
+        x_mid = curves.fletcher_gent_amplitudes(design)[2]
         self._loaded = [design]
         self.param.update(
             **_shown_values(design),
@@ -184,14 +182,15 @@ class ExplorerState(DesignFields, ToleranceBands):
         if read is None:
             return False
         data, (f, amp, _) = read
-        x = float(self.display_amplitude(amp))
-        lo, hi = self.amplitude_bounds
+        x = float(units.display_amplitude(amp, self.design.mode))
+        lo, hi = curves.amplitude_bounds(self.design)
+        unit = units.amplitude_unit(self.design.mode)
         problem = None
         if not FREQUENCY_BOUNDS[0] <= f <= FREQUENCY_BOUNDS[1]:
             problem = f"its frequency {f:.3g} Hz is outside {FREQUENCY_BOUNDS[0]:g}–{FREQUENCY_BOUNDS[1]:g} Hz"
         elif not lo <= x <= hi:
-            problem = (f"its amplitude {x:.3g} {self.amplitude_unit} is outside this bushing's amplitude axis "
-                       f"({lo:.3g}–{hi:.3g} {self.amplitude_unit})")
+            problem = (f"its amplitude {x:.3g} {unit} is outside this bushing's amplitude axis "
+                       f"({lo:.3g}–{hi:.3g} {unit})")
         if problem:
             self.data_message = f"{filename}: {problem}; not loaded"
             return False
@@ -202,12 +201,6 @@ class ExplorerState(DesignFields, ToleranceBands):
     def clear_measured(self):
         self.param.update(measured=None, measured_loop=None, data_message="", fit_result=None)
 
-    def measured_amplitudes(self) -> list[float]:
-        """The distinct measured amplitudes (SI), most frequent first."""
-        if self.measured is None:
-            return []
-        return [float(v) for v in self.measured.amplitudes()]
-
     def compute_fit(self) -> FitResult:
         """Fit the five material parameters to the measured data (the current design is the
         first start). Pure: safe to run in a worker thread; :meth:`store_fit` stores it."""
@@ -216,7 +209,7 @@ class ExplorerState(DesignFields, ToleranceBands):
         if self.fit_method == "two-step":
             if self.measured is None or self.measured_loop is None:
                 raise ValueError("the two-step fit needs a loop and a frequency sweep: load both")
-            amps = self.measured_amplitudes()
+            amps = measured_amplitudes(self.measured)
             amp = self.sweep_amplitude if self.sweep_amplitude in amps else amps[0]
             sweep = self.measured.select(self.measured.amplitude == amp)
             if len(sweep) < 3:
@@ -275,17 +268,6 @@ class ExplorerState(DesignFields, ToleranceBands):
         self.load_design(design)
         self.param.update(amplitude=amplitude, frequency_hz=frequency)
 
-    def measured_points(self) -> dict | None:
-        """Measured points in display units (as the data are: no model here)."""
-        return curves.measured_points(self.measured, self.design.mode)
-
-    def measured_residuals(self) -> dict | None:
-        """The design at each measured point against the data: |K| in %, the loss factor, the gap."""
-        return None if self.measured is None else curves.measured_residuals(self.design, self.measured)
-
-    def measured_loop_points(self) -> dict | None:
-        return curves.measured_loop_points(self.measured_loop, self.design.mode)
-
     def apply_url_values(self, values: dict):
         """Apply values from a shared link one by one, so one bad value spoils no other."""
         unusable = {}
@@ -297,32 +279,7 @@ class ExplorerState(DesignFields, ToleranceBands):
         if unusable:
             self.errors = {**self.errors, **unusable}
 
-    # ---- units and ranges ------------------------------------------------------------------
-
-    @property
-    def amplitude_unit(self) -> str:
-        return units.amplitude_unit(self.design.mode)
-
-    @property
-    def stiffness_unit(self) -> str:
-        return units.stiffness_unit(self.design.mode)
-
-    @staticmethod
-    def fletcher_gent_amplitudes(design: Design, n: int = 5) -> np.ndarray:
-        """Drive amplitudes (display units) spanning the Fletcher–Gent range, ε̂/ε½ = 1e-3 … 1e2,
-        at n log-spaced points."""
-        return curves.fletcher_gent_amplitudes(design, n)
-
-    @property
-    def amplitude_bounds(self) -> tuple[float, float]:
-        return curves.amplitude_bounds(self.design)
-
-    def _si_amplitude(self, x):
-        return units.to_si_amplitude(x, self.design.mode)
-
-    def display_amplitude(self, x_si):
-        """An amplitude in SI (m or rad) in the display unit (mm or rad)."""
-        return units.display_amplitude(x_si, self.design.mode)
+    # ---- validated values ------------------------------------------------------------------
 
     @property
     def freq_range(self) -> tuple[float, float]:
@@ -331,98 +288,16 @@ class ExplorerState(DesignFields, ToleranceBands):
             return 1.0, 100.0
         return float(self.freq_min), float(self.freq_max)
 
-    def frequency_grid(self, n: int = 120) -> np.ndarray:
-        return np.linspace(*self.freq_range, n)
-
-    def amplitude_grid(self, n: int = 120) -> np.ndarray:
-        return curves.amplitude_grid(self.design, n)
-
-    def sweep_amplitudes(self) -> np.ndarray:
-        """The amplitudes of the frequency sweeps: decades of ε̂/ε½ from 0.01 to 10."""
-        return curves.sweep_amplitudes(self.design)
-
-    def sweep_frequencies(self) -> np.ndarray:
-        return curves.sweep_frequencies(*self.freq_range)
-
-    # ---- data for the plots (no drawing) ---------------------------------------------------
-
-    def frequency_sweep(self, design: Design | None = None, amplitudes=None) -> dict:
-        """|K| (display unit) and loss factor against frequency at several amplitudes."""
-        design = design or self.design
-        amplitudes = self.sweep_amplitudes() if amplitudes is None else amplitudes
-        return curves.frequency_sweep(design, self.frequency_grid(), amplitudes)
-
-    def amplitude_sweep(self, design: Design | None = None, frequencies=None) -> dict:
-        """|K| (display unit) and loss factor against amplitude at several frequencies."""
-        design = design or self.design
-        frequencies = self.sweep_frequencies() if frequencies is None else frequencies
-        return curves.amplitude_sweep(design, self.amplitude_grid(), frequencies)
-
-    def hysteresis_loop(self, design: Design | None = None, amplitude=None, points: int = 200):
-        """One steady period at the operating point (or ``amplitude``), display units."""
-        x = self.amplitude if amplitude is None else amplitude
-        return curves.hysteresis_loop(design or self.design, self.frequency_hz, x, points)
-
-    def slice_comparison(self, n: int = 60) -> dict:
-        """|K| and loss factor against amplitude at the operating frequency for 1, 2, 3 slices
-        and the continuum, with the differences from the single modulus in %."""
-        return curves.slice_comparison(self.design, self.frequency_hz, self.amplitude_grid(n))
-
-    def branch_breakdown(self, n: int = 80) -> dict:
-        """How the elastic, viscoelastic and friction branches make up K against amplitude at
-        the operating frequency."""
-        return curves.branch_breakdown(self.design, self.frequency_hz, self.amplitude_grid(n))
-
-    def operating_point(self, design: Design | None = None) -> dict:
-        return curves.operating_point(design or self.design, self.frequency_hz, self.amplitude)
-
-    def explorer_data(self):
-        """Everything the explorer's five plots show (:func:`app.curves.explorer_data`)."""
-        bands = self.banded(lambda tol: curves.operating_bands(
-            self.design, self.frequency_hz, self.amplitude, self.frequency_grid(), self.amplitude_grid(), tol,
-            self._band_cache))
-        return curves.explorer_data(self.design, self.frequency_hz, self.amplitude, freq_range=self.freq_range,
-                                    reference=self.reference, measured=self.measured,
-                                    measured_loop=self.measured_loop, bands=bands)
-
-    def comparison(self) -> dict | None:
-        """Current design against the pinned reference, in %, at the operating point and over
-        the sweeps (largest difference)."""
-        if self.reference is None:
-            return None
-        now, ref = self.operating_point(), self.operating_point(self.reference)
-        fs_now, fs_ref = self.frequency_sweep(amplitudes=self.amplitude), self.frequency_sweep(self.reference, self.amplitude)
-        as_now, as_ref = self.amplitude_sweep(frequencies=self.frequency_hz), self.amplitude_sweep(self.reference, self.frequency_hz)
-
-        def worst(a, b):
-            d = 100 * (a / b - 1)
-            return float(d.flat[np.argmax(np.abs(d))])
-
-        return {
-            "operating": {
-                "magnitude": (now["magnitude"], ref["magnitude"], 100 * (now["magnitude"] / ref["magnitude"] - 1)),
-                "loss_factor": (now["loss_factor"], ref["loss_factor"], 100 * (now["loss_factor"] / ref["loss_factor"] - 1)),
-            },
-            "largest_over_frequency": {k: worst(fs_now[k], fs_ref[k]) for k in ("magnitude", "loss_factor")},
-            "largest_over_amplitude": {k: worst(as_now[k], as_ref[k]) for k in ("magnitude", "loss_factor")},
-        }
-
     def pin_reference(self):
         self.reference = self.design
 
     def clear_reference(self):
         self.reference = None
 
-    # ---- export ------------------------------------------------------------------------------
 
-    def stiffness_table(self, n_freq: int = 25, n_amp: int = 25) -> dict:
-        """The docs/files.md stiffness table over the sweeps' frequency range and the
-        Fletcher–Gent amplitude range (SI units); with the tolerance bands on, their percentile
-        columns too (those of ``bushing stiffness --tolerance``)."""
-        f, x = self.frequency_grid(n_freq), self._si_amplitude(self.amplitude_grid(n_amp))
-        table = stiffness(self.design, f, x).table()
-        columns = self.banded(lambda tol: band_columns(band(self.design, f[None, :], np.asarray(x)[:, None], tol)))
-        return {**table, **(columns or {})}
+def measured_amplitudes(measured: MeasuredStiffness | None) -> list[float]:
+    """The distinct measured amplitudes (SI), most frequent first."""
+    return [] if measured is None else [float(v) for v in measured.amplitudes()]
 
 
 def _match_shown(design: Design, known) -> Design:

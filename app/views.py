@@ -7,6 +7,7 @@ import numpy as np
 import panel as pn
 import param
 
+from .curves import amplitude_bounds
 from .live import update_or_keep
 from .plotting.style import dimensions
 from .state import ExplorerState
@@ -55,7 +56,7 @@ class PlotView(pn.viewable.Viewer):
     def tap_amplitude(self, x):
         """A tap on an amplitude axis: the operating amplitude moves there (within its range)."""
         if x is not None and np.isfinite(x) and x > 0:
-            lo, hi = self.state.amplitude_bounds
+            lo, hi = amplitude_bounds(self.state.design)
             self.state.amplitude = float(np.clip(float(f"{x:.4g}"), lo, hi))
 
     def tap_frequency(self, x):

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from app import curves
 from app.main import App, create_app
 from app.state import ExplorerState
 from core import PAPER_B, TABLE_1, loads_design, loop, stiffness
@@ -183,7 +184,8 @@ def test_link_values_are_applied_one_by_one():
 
 
 def test_slices_view_holds_the_core_numbers(app):
-    data = app.state.slice_comparison()
+    s = app.state
+    data = curves.slice_comparison(s.design, s.frequency_hz, curves.amplitude_grid(s.design, 60))
     x = data["amplitude"] * 1e-3
     for sl in (1, 2, 3, "continuum"):
         ref = stiffness(PAPER_B, app.state.frequency_hz, x, slices=sl)
@@ -198,7 +200,8 @@ def test_slices_view_holds_the_core_numbers(app):
 
 
 def test_teaching_branches_add_up_to_the_stiffness(app):
-    d = app.state.branch_breakdown()
+    s = app.state
+    d = curves.branch_breakdown(s.design, s.frequency_hz, curves.amplitude_grid(s.design, 80))
     x = d["amplitude"] * 1e-3
     ref = stiffness(PAPER_B, app.state.frequency_hz, x)
     assert_allclose(sum(d["real"].values()), ref.stiffness.real[:, 0] / 1e6, rtol=1e-12)
@@ -209,7 +212,7 @@ def test_teaching_branches_add_up_to_the_stiffness(app):
     assert_allclose(band.dimension_values(1), ref.stiffness.real[:, 0] / 1e6, rtol=1e-12)
     assert_allclose(band.dimension_values(2), (d["real"]["elastic"] + d["real"]["viscoelastic"]), rtol=1e-12)
     app.teaching.player.value = 3
-    x = np.geomspace(*app.state.amplitude_bounds, app.teaching.FRAMES)[3]
+    x = np.geomspace(*curves.amplitude_bounds(s.design), app.teaching.FRAMES)[3]
     assert f"{x:.3g} mm" in app.teaching.frame_label.object
     shape = loop(PAPER_B, app.state.frequency_hz, x * 1e-3, 200)
     _, f = xy(app.teaching.frame("loop"), "total")
@@ -218,10 +221,14 @@ def test_teaching_branches_add_up_to_the_stiffness(app):
 
 def test_comparison_with_a_pinned_reference(app):
     s = app.state
-    assert s.comparison() is None
+
+    def comparison():
+        return curves.comparison(s.design, s.reference, s.frequency_hz, s.amplitude, s.freq_range)
+
+    assert comparison() is None
     s.pin_reference()
     s.length_mm = 99.0  # stiffness ∝ L: +10 %
-    c = s.comparison()
+    c = comparison()
     assert c["operating"]["magnitude"][2] == pytest.approx(10.0, rel=1e-9)
     assert c["operating"]["loss_factor"][2] == pytest.approx(0.0, abs=1e-9)
     assert c["largest_over_frequency"]["magnitude"] == pytest.approx(10.0, rel=1e-9)
@@ -231,7 +238,7 @@ def test_comparison_with_a_pinned_reference(app):
     assert_allclose(ref_loop * 1.1, data(app.plots.frame("loop"), "total")[1], rtol=1e-12)
     assert "+10.00 %" in app.compare.table(s.reference, s.design, s.frequency_hz, s.amplitude, s.errors)
     s.clear_reference()
-    assert s.comparison() is None
+    assert comparison() is None
     assert "reference" not in [el.label for el in overlay(app, "magnitude", "frequency")]
 
 
@@ -246,15 +253,12 @@ def test_exports_are_the_public_formats(app):
     assert_allclose(data[data[:, 1] == data[0, 1], 4], ref.magnitude[0, data[:, 1] == data[0, 1]], rtol=1e-10)
 
 
-def test_a_failing_refresh_keeps_the_last_plots_and_logs_one_line(app, caplog):
+def test_a_failing_refresh_keeps_the_last_plots_and_logs_one_line(app, caplog, monkeypatch):
     good = data(overlay(app, "magnitude", "frequency"), "operating point")[1]
-    original = app.state.explorer_data
-    app.state.explorer_data = lambda *a, **k: 1 / 0
-    try:
-        with caplog.at_level(logging.WARNING, logger="bushing.app"):
-            app.state.shear_modulus_mpa = 3.0
-    finally:
-        app.state.explorer_data = original
+    monkeypatch.setattr(curves, "explorer_data", lambda *a, **k: 1 / 0)
+    with caplog.at_level(logging.WARNING, logger="bushing.app"):
+        app.state.shear_modulus_mpa = 3.0
+    monkeypatch.undo()
     assert_allclose(data(overlay(app, "magnitude", "frequency"), "operating point")[1], good)
     assert len(caplog.records) == 1 and caplog.records[0].exc_info is None
     assert "ZeroDivisionError" in caplog.records[0].getMessage()

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from app import curves
 from app.main import App
 from core import PAPER_B, loads_design, stiffness_points
 from tests.helpers import xy
@@ -31,11 +32,11 @@ def test_measured_points_appear_over_the_model(app):
     app.tabs.active = 0
     x, y = xy(app.plots.frame(("magnitude", "frequency")), "measured")
     assert len(x) == 150 and np.all(y > 0)
-    points = app.state.measured_points()
+    points = curves.measured_points(app.state.measured, app.state.design.mode)
     assert_allclose(y, points["magnitude"])
     assert_allclose(x, points["frequency_hz"])
     app.tabs.active = 3  # the residual plots hold the state's numbers
-    residuals = app.state.measured_residuals()
+    residuals = curves.measured_residuals(app.state.design, app.state.measured)
     assert_allclose(xy(app.measured.frame("magnitude", "frequency"), "residual")[1],
                     residuals["magnitude_residual_pct"])
     # exact data of a bushing 10 % longer (K ∝ L, the loss factor unchanged): the explorer's
@@ -46,7 +47,7 @@ def test_measured_points_appear_over_the_model(app):
     longer = synthetic_stiffness(PAPER_B.replace(geometry=PAPER_B.geometry.__class__(0.020, 0.035, 0.099)),
                                  np.linspace(1, 100, 7), [1e-5, 1e-4, 1e-3], noise=0.0)
     assert app.state.load_measured(longer.to_csv(), "longer.csv")
-    residuals = app.state.measured_residuals()
+    residuals = curves.measured_residuals(app.state.design, app.state.measured)
     assert_allclose(residuals["magnitude_residual_pct"], 100 * (1 / 1.1 - 1), rtol=1e-8)
     assert_allclose(residuals["loss_factor_residual"], 0.0, atol=1e-9)
     assert residuals["gap"] == pytest.approx(1 / 11, rel=1e-6)  # |K_model − K_data| / |K_data| = 1 − 1/1.1
@@ -69,7 +70,7 @@ def test_dense_data_are_drawn_as_bin_means_with_the_gap_over_every_point(app):
     x, _ = xy(app.plots.frame(("magnitude", "frequency")), "measured")
     assert len(x) == DISPLAY_POINTS
     every = gap(stiffness_points(app.state.design, dense.frequency_hz, dense.amplitude), dense.stiffness)
-    assert app.state.measured_residuals()["gap"] == pytest.approx(every, rel=1e-9)
+    assert curves.measured_residuals(app.state.design, app.state.measured)["gap"] == pytest.approx(every, rel=1e-9)
     app.tabs.active = 3
     assert f"drawn as {DISPLAY_POINTS} bin means" in app.measured.summary.object
     loop = synthetic_loop(PAPER_B, 1.0, 1e-4, periods=4, per_period=5000, seed=3)
@@ -106,7 +107,7 @@ def test_fit_in_the_app_and_take_it_into_the_explorer(app):
     app.state.use_fit()
     assert app.state.design.material.shear_modulus == pytest.approx(r.design.material.shear_modulus, rel=1e-9)
     assert (app.state.frequency_hz, app.state.amplitude) == (f_op, x_op)
-    assert app.state.measured_residuals()["gap"] == pytest.approx(r.gap, rel=1e-6)
+    assert curves.measured_residuals(app.state.design, app.state.measured)["gap"] == pytest.approx(r.gap, rel=1e-6)
     fitted = loads_design(app.measured._fitted_json().getvalue())
     assert fitted.material == r.design.material
 

@@ -6,6 +6,7 @@ session's memory kept flat, and hostile values from the page."""
 import numpy as np
 import pytest
 
+from app.curves import amplitude_bounds
 from app.main import App
 from core import PAPER_B
 from tests.helpers import figures, rendered, xy
@@ -33,7 +34,7 @@ def test_axes_of_a_quantity_are_shared_and_cover_every_curve(app):
     x = xy(app.plots.frame(("magnitude", "amplitude")), "operating point")[0]
     lo, hi = np.log10(x.min()), np.log10(x.max())
     assert np.log10([k_a.x_range.start, k_a.x_range.end]) == pytest.approx([lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo)])
-    assert x.min() == pytest.approx(app.state.amplitude_bounds[0])
+    assert x.min() == pytest.approx(amplitude_bounds(app.state.design)[0])
 
 
 def test_legends_hide_curves_on_click_and_follow_the_overlay(app):
@@ -138,7 +139,7 @@ def test_the_slider_keeps_its_own_position(app):
     app.state.shear_modulus_mpa = 2.5  # a new design with the same amplitude bounds
     assert slider.value == -1.2345678
     app.state.friction_strain_half = app.state.friction_strain_half * 1000  # new bounds
-    lo, hi = app.state.amplitude_bounds
+    lo, hi = amplitude_bounds(app.state.design)
     assert np.log10(lo) <= slider.value <= np.log10(hi)
     assert abs(slider.value - np.log10(app.state.amplitude)) <= slider.step / 2
 
@@ -213,7 +214,7 @@ def test_hostile_values_from_the_page_leave_a_message_or_nothing(app, caplog):
     slider = app.inputs.amplitude.slider
     before = app.state.amplitude
     slider.value = 400.0  # 10^400 mm: beyond any float
-    assert app.state.amplitude == pytest.approx(app.state.amplitude_bounds[1], rel=1e-3)
+    assert app.state.amplitude == pytest.approx(amplitude_bounds(app.state.design)[1], rel=1e-3)
     slider.value = float("nan")
     assert np.isfinite(app.state.amplitude)
     app.state.amplitude = before

@@ -45,13 +45,13 @@ def test_bands_on_the_explorer_are_the_cores(app):
     card = app.card.frame("translation")
     assert {e.label for e in card} >= {"axial band", "radial band"}
     # the stiffness table download carries the band's percentile columns
-    table = app.state.stiffness_table(n_freq=5, n_amp=4)
+    table = app.export.stiffness_table(n_freq=5, n_amp=4)
     assert list(table)[-6:] == ["magnitude_p5", "magnitude_p50", "magnitude_p95", "loss_factor_p5",
                                 "loss_factor_p50", "loss_factor_p95"]
     assert np.all(table["magnitude_p5"] < table["magnitude"]) and np.all(table["magnitude"] < table["magnitude_p95"])
     app.state.band_on = False
     assert all(e.label != "5–95 % band" for e in app.plots.frame(("magnitude", "frequency")))
-    assert "magnitude_p5" not in app.state.stiffness_table(n_freq=5, n_amp=4)
+    assert "magnitude_p5" not in app.export.stiffness_table(n_freq=5, n_amp=4)
 
 
 def test_tolerances_that_cannot_be_used_say_why_and_keep_the_plots(app):

@@ -24,7 +24,7 @@ from .style import (
 def residual_overlays(points: dict | None, residuals: dict | None, dims: dict) -> dict:
     """Model − measured at every measured point: |K| in % and the loss factor, against
     frequency and amplitude (``points`` from :func:`app.curves.measured_points`, ``residuals`` as
-    :meth:`app.state.ExplorerState.measured_residuals`)."""
+    :func:`app.curves.measured_residuals`)."""
     out = {}
     for against in ("frequency", "amplitude"):
         x = [] if points is None else points["frequency_hz" if against == "frequency" else "amplitude"]

@@ -5,9 +5,11 @@ pinned reference."""
 from __future__ import annotations
 
 import holoviews as hv
+import numpy as np
 import panel as pn
 import param
 
+from .. import curves, units
 from ..bands import BAND_PARAMETERS
 from ..live import LivePlot
 from ..plotting.explorer import explorer_labels, explorer_overlays, on_ranges, sweep_curves
@@ -30,6 +32,7 @@ class ExplorerPlots(PlotView):
         self.loop: LivePlot | None = None
         self.grid: LivePlot | None = None
         self._sweeps, self._sweeps_key = {}, None
+        self._band_cache: dict = {}  # the last few tolerance bands (app.curves.operating_bands)
         self._update()  # built outside a held document: held, the new panes are laid out wrong
 
     @param.depends("state.design", "state.freq_min", "state.freq_max", "state.errors", "state.frequency_hz",
@@ -44,7 +47,11 @@ class ExplorerPlots(PlotView):
 
     def _update(self):
         s = self.state
-        data = s.explorer_data()
+        design, f, x, freq_range = s.design, s.frequency_hz, s.amplitude, s.freq_range
+        bands = s.banded(lambda tol: curves.operating_bands(
+            design, f, x, np.linspace(*freq_range, 120), curves.amplitude_grid(design), tol, self._band_cache))
+        data = curves.explorer_data(design, f, x, freq_range=freq_range, reference=s.reference,
+                                    measured=s.measured, measured_loop=s.measured_loop, bands=bands)
         self.dims_for(data.mode)  # new units: new axes
         key = (s.design, s.freq_range)
         if key != self._sweeps_key:  # the sweeps change with the design, not the operating point
@@ -64,12 +71,13 @@ class ExplorerPlots(PlotView):
         else:
             self.loop.show([overlays["loop"]])
             self.grid.show(grid)
-        point = s.operating_point()
+        point = curves.operating_point(design, f, x)
+        amplitude_unit, stiffness_unit = units.amplitude_unit(design.mode), units.stiffness_unit(design.mode)
         self.summary.object = (
-            f'<span class="op-summary"><b>Operating point</b>: <span class="op-point">{s.amplitude:.3g} '
-            f"{s.amplitude_unit}, {s.frequency_hz:.3g} Hz</span> &nbsp;→&nbsp; |K| = "
-            f"<b>{point['magnitude']:.4g} {s.stiffness_unit}</b>, loss factor <b>{point['loss_factor']:.4f}</b></span>"
-            + (f'<br><span class="band-summary">{band_words(data.bands["point"], s.stiffness_unit)}</span>'
+            f'<span class="op-summary"><b>Operating point</b>: <span class="op-point">{x:.3g} '
+            f"{amplitude_unit}, {f:.3g} Hz</span> &nbsp;→&nbsp; |K| = "
+            f"<b>{point['magnitude']:.4g} {stiffness_unit}</b>, loss factor <b>{point['loss_factor']:.4f}</b></span>"
+            + (f'<br><span class="band-summary">{band_words(data.bands["point"], stiffness_unit)}</span>'
                if data.bands else "")
             + (f'<br><span class="band-message" style="color:#8a5300">No tolerance band: {s.band_message}</span>'
                if s.band_message else "")
@@ -107,15 +115,15 @@ class CompareView(pn.viewable.Viewer):
         self.clear.on_click(lambda _e: state.clear_reference())
 
     def table(self, reference, design, f, x, errors):
-        c = self.state.comparison()
+        c = curves.comparison(design, reference, f, x, self.state.freq_range)
         if c is None:
             return "_No reference pinned: press **Pin as reference**, then change the design._"
         if reference.mode != design.mode:
             return "_The reference is in another mode; switch back to compare._"
-        unit = self.state.stiffness_unit
+        unit = units.stiffness_unit(design.mode)
         (m_now, m_ref, m_d), (e_now, e_ref, e_d) = c["operating"]["magnitude"], c["operating"]["loss_factor"]
         return (
-            f"| at {f:.3g} Hz, {x:.3g} {self.state.amplitude_unit} | this design | reference | difference |\n|---|---|---|---|\n"
+            f"| at {f:.3g} Hz, {x:.3g} {units.amplitude_unit(design.mode)} | this design | reference | difference |\n|---|---|---|---|\n"
             f"| \\|K\\| ({unit}) | {m_now:.4g} | {m_ref:.4g} | {pct(m_d)} |\n"
             f"| loss factor | {e_now:.4f} | {e_ref:.4f} | {pct(e_d)} |\n\n"
             f"Largest difference over the frequency sweep: \\|K\\| {pct(c['largest_over_frequency']['magnitude'])}, "

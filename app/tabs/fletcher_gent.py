@@ -7,11 +7,12 @@ import numpy as np
 import panel as pn
 import param
 
-from ..curves import padded
+from ..curves import amplitude_bounds, amplitude_grid, branch_breakdown, hysteresis_loop, padded
 from ..live import LivePlot, update_or_keep
 from ..plotting.fletcher_gent import branch_overlays, loop_shape_overlay
 from ..plotting.style import ranged
 from ..state import ExplorerState
+from ..units import amplitude_unit
 from ..views import PlotView
 
 TEACHING_TEXT = """
@@ -56,7 +57,8 @@ class TeachingView(PlotView):
         return self.loop.current[0] if which == "loop" else self.branches.current[WHICH.index(which)]
 
     def _update(self):
-        d = self.state.branch_breakdown()
+        s = self.state
+        d = branch_breakdown(s.design, s.frequency_hz, amplitude_grid(s.design, 80))
         totals = {which: sum(d[which].values()) for which in WHICH}
         dims = ranged(self.dims_for(self.state.design.mode), {
             "amplitude": padded([d["amplitude"]], log=True), "real": padded([np.zeros(1), totals["real"]]),
@@ -70,11 +72,12 @@ class TeachingView(PlotView):
         update_or_keep("TeachingView kept its last frame", self._draw_frame)
 
     def _draw_frame(self):
-        x = np.geomspace(*self.state.amplitude_bounds, self.FRAMES)[self.player.value]
-        shape = loop_shape_overlay(self.state.hysteresis_loop(amplitude=x), self.dims)
+        s = self.state
+        x = np.geomspace(*amplitude_bounds(s.design), self.FRAMES)[self.player.value]
+        shape = loop_shape_overlay(hysteresis_loop(s.design, s.frequency_hz, x), self.dims)
         self.loop = LivePlot.shown(self.loop, [shape])
         self.frame_label.object = (f'<span class="frame-point">Loop shape at <b>{x:.3g} '
-                                   f"{self.state.amplitude_unit}</b>, {self.state.frequency_hz:.3g} Hz</span>")
+                                   f"{amplitude_unit(s.design.mode)}</b>, {s.frequency_hz:.3g} Hz</span>")
 
     def __panel__(self):
         return pn.Column(

@@ -15,12 +15,12 @@ from core import PAPER_B
 from core.parameters import BY_NAME, MATERIAL
 from core.synthetic import paper_b_example
 
-from .. import curves
+from .. import curves, units
 from ..curves import padded
 from ..live import LivePlot
 from ..plotting.measured_data_and_fit import prediction_overlay, residual_overlays
 from ..plotting.style import ranged
-from ..state import ExplorerState
+from ..state import ExplorerState, measured_amplitudes
 from ..uploads import csv_dropper, on_files, on_upload
 from ..views import PlotView
 
@@ -100,7 +100,10 @@ class MeasuredView(PlotView):
         s = self.state
         self.message.object = (f'<div class="data-error" style="color:#b03a2e">⚠ {s.data_message}</div>'
                                if s.data_message else "")
-        points, residuals = s.measured_points(), s.measured_residuals()
+        mode = s.design.mode
+        unit = units.amplitude_unit(mode)
+        points = curves.measured_points(s.measured, mode)
+        residuals = None if s.measured is None else curves.measured_residuals(s.design, s.measured)
         lines = []
         if s.measured is not None:
             d = s.measured
@@ -113,17 +116,17 @@ class MeasuredView(PlotView):
                 lines.append(
                     f"**Stiffness**: {len(d)} points{modes}{shown}, {d.frequency_hz.min():.3g}–"
                     f"{d.frequency_hz.max():.3g} Hz, amplitudes {points['amplitude'].min():.3g}–"
-                    f"{points['amplitude'].max():.3g} {s.amplitude_unit}; gap of the current design: "
+                    f"{points['amplitude'].max():.3g} {unit}; gap of the current design: "
                     f"**{residuals['gap']:.4f}**"
                     + (f" (drawn as {len(points['frequency_hz'])} bin means; fits bin them too)"
                        if len(points["frequency_hz"]) < len(d.of_mode(s.design.mode)) else ""))
         if s.measured_loop is not None:
             f, amp, _ = s.measured_loop.harmonic()
             lines.append(f"**Loop**: {s.measured_loop.time_s.size} samples at {f:.3g} Hz, amplitude "
-                         f"{s.display_amplitude(amp):.3g} {s.amplitude_unit}")
+                         f"{units.display_amplitude(amp, mode):.3g} {unit}")
         self.summary.object = "\n\n".join(lines) or "_No measured data loaded._"
         self._draw(points, residuals)
-        options = {f"{s.display_amplitude(a):.4g} {s.amplitude_unit}": a for a in s.measured_amplitudes()}
+        options = {f"{units.display_amplitude(a, mode):.4g} {unit}": a for a in measured_amplitudes(s.measured)}
         if options != self.sweep.options:
             self.sweep.options = options
         self.sweep.visible = s.fit_method == "two-step"

@@ -6,11 +6,12 @@ import numpy as np
 import panel as pn
 import param
 
-from ..curves import padded
+from ..curves import amplitude_grid, padded, slice_comparison
 from ..live import LivePlot
 from ..plotting.slices import SLICE_NAMES, slices_overlays
 from ..plotting.style import ranged
 from ..state import ExplorerState
+from ..units import amplitude_unit
 from ..views import PlotView
 
 WHICH = ("magnitude", "magnitude_diff_pct", "loss_factor")
@@ -35,7 +36,8 @@ class SlicesView(PlotView):
         return self.plots.current[WHICH.index(which)]
 
     def _update(self):
-        data = self.state.slice_comparison()
+        s = self.state
+        data = slice_comparison(s.design, s.frequency_hz, amplitude_grid(s.design, 60))
         dims = ranged(self.dims_for(self.state.design.mode), {"amplitude": padded([data["amplitude"]], log=True)})
         overlays = slices_overlays(data, dims, self.state.amplitude)
         items = [overlays[w] for w in WHICH]
@@ -43,7 +45,7 @@ class SlicesView(PlotView):
         self.table.object = self.summary(data)
 
     def summary(self, data):
-        xs, unit = data["amplitude"], self.state.amplitude_unit
+        xs, unit = data["amplitude"], amplitude_unit(self.state.design.mode)
         rows = ["| model | largest \\|K\\| difference | largest loss-factor difference |", "|---|---|---|"]
         for s in (2, 3, "continuum"):
             if s in data["magnitude_diff_pct"]:

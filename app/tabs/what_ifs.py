@@ -170,7 +170,7 @@ class WhatIfView(PlotView):
             items.append(sensitivity_bars(bars, title, color, f"bushing-sensitivity-{quantity.replace('_', '-')}"))
         self.bars = LivePlot.shown(self.bars, items)
         s = self.state
-        self.sentence.object = (f"At {s.frequency_hz:.3g} Hz and {s.amplitude:.3g} {s.amplitude_unit}: "
+        self.sentence.object = (f"At {s.frequency_hz:.3g} Hz and {s.amplitude:.3g} {units.amplitude_unit(s.design.mode)}: "
                                 f"{sentence(values)}")
 
     # ---- targets ---------------------------------------------------------------------------------
