@@ -103,6 +103,7 @@ class App(pn.viewable.Viewer):
         if 1 <= active <= len(self.LAZY_TABS):
             self.view(self.LAZY_TABS[active - 1][1])
         self.plots.show(active == 0)
+        self.compare.show(active == 0)
         for index, (_title, name, _build) in enumerate(self.LAZY_TABS, start=1):
             view = self._built.get(name)
             if isinstance(view, PlotView):

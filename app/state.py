@@ -21,7 +21,7 @@ from core.io.measured import combined, parse_loop, parse_stiffness
 from core.parameters import MODE_TABLE, MODES
 
 from . import curves, units
-from .bands import ToleranceBands
+from .bands import BAND_PARAMETERS, ToleranceBands
 from .fields import DESIGN_FIELDS, DesignFields, design_from_fields, display_values
 from .units import FREQUENCY_BOUNDS
 
@@ -82,8 +82,12 @@ class ExplorerState(DesignFields, ToleranceBands):
     freq_min = param.Number(1.0, allow_None=True, label="Sweep from (Hz)", doc="Lowest frequency of the sweeps.")
     freq_max = param.Number(100.0, allow_None=True, label="Sweep to (Hz)", doc="Highest frequency of the sweeps.")
 
-    design = param.ClassSelector(class_=Design, default=PAPER_B, doc="The last valid design (SI).")
-    errors = param.Dict(default={}, doc="Input field → what is wrong with it.")
+    # computed from the inputs above (read-only: ExplorerState._derive writes them, in one update)
+    design = param.ClassSelector(class_=Design, default=PAPER_B, constant=True, doc="The last valid design (SI).")
+    errors = param.Dict(default={}, constant=True, doc="Input field → what is wrong with it.")
+    freq_range = param.NumericTuple(default=(1.0, 100.0), length=2, constant=True,
+                                    doc="The sweeps' frequency range (Hz): freq_min to freq_max, or 1–100 Hz "
+                                    "while they are not valid.")
     reference = param.ClassSelector(class_=Design, default=None, allow_None=True, doc="Pinned design.")
 
     effects = param.Dict(default={}, doc="Model extensions carried by a loaded design.")
@@ -107,11 +111,10 @@ class ExplorerState(DesignFields, ToleranceBands):
                           "predicts the others, with the gap of each mode and amplitude.")
 
     def __init__(self, **params):
-        self._band_cache: dict = {}  # the last few tolerance bands (app.curves.operating_bands)
         self._loaded = []  # the last design loaded (a file, a fit): kept while the inputs show it
         super().__init__(**params)
-        self.param.watch(self._keep_strain_on_mode_change, ["mode", "amplitude"])
-        self._validate()
+        self.param.watch(self._derive, [*DERIVED_FROM, "amplitude"])
+        self._derive()
 
     # ---- inputs → design -------------------------------------------------------------------
 
@@ -121,39 +124,32 @@ class ExplorerState(DesignFields, ToleranceBands):
             return
         self.load_design(PRESETS[self.preset])
 
-    def _keep_strain_on_mode_change(self, *events):
-        """The amplitude changes unit with the mode: keep the same equivalent strain, unless the
-        amplitude was set together with the mode (a preset, a link)."""
+    def _derive(self, *events):
+        """The computed values (design, errors, freq_range) from the inputs, in one update: a view
+        that draws several of them is told once. A mode changed alone (not with the amplitude, as
+        a preset or a link sets both) also moves the amplitude to the same equivalent strain in
+        the new mode's unit."""
         names = {e.name for e in events}
-        if names != {"mode"}:
+        if names == {"amplitude"}:
             return
-        old, new = events[0].old, events[0].new
-        d, shape = self.design, "finite" if self.finite_length else None
-        try:
-            eps = Design(old, d.geometry, d.material, shape=shape).strain(units.to_si_amplitude(self.amplitude, old))
-            x = units.display_amplitude(Design(new, d.geometry, d.material, shape=shape).drive(eps), new)
-        except ValueError:  # a geometry outside the finite-length table: the validation says so
-            return
-        self.amplitude = float(f"{x:.3g}")
-
-    @param.depends(*DESIGN_FIELDS, "mode", "finite_length", "effects", "freq_min", "freq_max", watch=True,
-                   on_init=False)
-    def _validate(self):
         shape = "finite" if self.finite_length else None
         fields = {name: getattr(self, name) for name in DESIGN_FIELDS}
         design, errors = design_from_fields(fields, self.design, self.mode, shape, self.effects)
-        if design is not None:
-            design = _match_shown(design, [*PRESETS.values(), *self._loaded])
-            if design != self.design:
-                self.design = design
-        fmin, fmax = self.freq_min, self.freq_max
-        if fmin is None or not math.isfinite(fmin) or fmin <= 0:
-            errors["freq_min"] = "Enter a positive frequency."
-        elif fmax is None or not math.isfinite(fmax) or fmax <= fmin:
-            errors["freq_max"] = "Must be above the lowest frequency."
-        elif fmax > FREQUENCY_BOUNDS[1]:
-            errors["freq_max"] = f"At most {FREQUENCY_BOUNDS[1]:g} Hz."
-        self.errors = errors
+        design = self.design if design is None else _match_shown(design, [*PRESETS.values(), *self._loaded])
+        errors.update(frequency_errors(self.freq_min, self.freq_max))
+        values = {"freq_range": (1.0, 100.0) if {"freq_min", "freq_max"} & set(errors)
+                  else (float(self.freq_min), float(self.freq_max))}
+        if design != self.design:
+            values["design"] = design
+        if errors != self.errors:
+            values["errors"] = errors
+        if names == {"mode"}:
+            (event,) = events
+            amplitude = same_strain(self.amplitude, event.old, event.new, design, shape)
+            if amplitude is not None:
+                values["amplitude"] = amplitude
+        with param.edit_constant(self):
+            self.param.update(values)
 
     def load_design(self, design: Design):
         """Show ``design`` (a preset, a file, a fit), its operating amplitude mid-range."""
@@ -277,16 +273,8 @@ class ExplorerState(DesignFields, ToleranceBands):
             except Exception:  # noqa: BLE001 - a bad link value: keep the default, say so
                 unusable[name] = f"The link's value {value!r} was not usable; kept {getattr(self, name)!r}."
         if unusable:
-            self.errors = {**self.errors, **unusable}
-
-    # ---- validated values ------------------------------------------------------------------
-
-    @property
-    def freq_range(self) -> tuple[float, float]:
-        """The sweeps' frequency range, or 1–100 Hz while the input is not valid."""
-        if "freq_min" in self.errors or "freq_max" in self.errors:
-            return 1.0, 100.0
-        return float(self.freq_min), float(self.freq_max)
+            with param.edit_constant(self):
+                self.errors = {**self.errors, **unusable}
 
     def pin_reference(self):
         self.reference = self.design
@@ -295,9 +283,52 @@ class ExplorerState(DesignFields, ToleranceBands):
         self.reference = None
 
 
+# what the computed values (design, errors, freq_range) are computed from
+DERIVED_FROM = (*DESIGN_FIELDS, "mode", "finite_length", "effects", "freq_min", "freq_max")
+
+
+def frequency_errors(freq_min, freq_max) -> dict[str, str]:
+    """What is wrong with the sweeps' frequency range (field → message), or nothing."""
+    if freq_min is None or not math.isfinite(freq_min) or freq_min <= 0:
+        return {"freq_min": "Enter a positive frequency."}
+    if freq_max is None or not math.isfinite(freq_max) or freq_max <= freq_min:
+        return {"freq_max": "Must be above the lowest frequency."}
+    if freq_max > FREQUENCY_BOUNDS[1]:
+        return {"freq_max": f"At most {FREQUENCY_BOUNDS[1]:g} Hz."}
+    return {}
+
+
+def same_strain(amplitude: float, old: str, new: str, design: Design, shape: str | None) -> float | None:
+    """The drive amplitude (display units of mode ``new``, 3 digits) at the equivalent strain
+    that ``amplitude`` (display units of mode ``old``) gives ``design``'s bushing, or None for a
+    geometry outside the finite-length table (the validation says so)."""
+    g, m = design.geometry, design.material
+    try:
+        eps = Design(old, g, m, shape=shape).strain(units.to_si_amplitude(amplitude, old))
+        x = units.display_amplitude(Design(new, g, m, shape=shape).drive(eps), new)
+    except ValueError:
+        return None
+    return float(f"{x:.3g}")
+
+
 def measured_amplitudes(measured: MeasuredStiffness | None) -> list[float]:
     """The distinct measured amplitudes (SI), most frequent first."""
     return [] if measured is None else [float(v) for v in measured.amplitudes()]
+
+
+# what the views draw, by what it is: the state's parameters of each (a view names the ones it
+# shows, app.views.PlotView.shows; it is told of a change of any of their parameters)
+SHOWN = {
+    "design": ("design",),  # the last valid design (SI)
+    "frequency": ("frequency_hz",),  # the operating point's frequency
+    "amplitude": ("amplitude",),  # the operating point's amplitude (display units)
+    "sweep range": ("freq_range",),
+    "reference": ("reference",),
+    "measured": ("measured", "measured_loop"),
+    "bands": BAND_PARAMETERS,
+    "data message": ("data_message",),
+    "fit": ("fit_result", "fit_method"),
+}
 
 
 def _match_shown(design: Design, known) -> Design:

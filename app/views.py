@@ -10,22 +10,59 @@ import param
 from .curves import amplitude_bounds
 from .live import update_or_keep
 from .plotting.style import dimensions
-from .state import ExplorerState
+from .state import SHOWN, ExplorerState
 from .units import OPERATING_FREQUENCIES
 
 
+def _same(a, b) -> bool:
+    """Whether two values a view draws are the same (the same object, or equal; values that
+    cannot say, such as arrays, are not)."""
+    if a is b:
+        return True
+    try:
+        return bool(a == b)
+    except (TypeError, ValueError):
+        return False
+
+
 class PlotView(pn.viewable.Viewer):
-    """Plots of one tab. A subclass declares what it shows with ``@param.depends("state.…",
-    watch=True)`` on a method that calls :meth:`changed`, and draws in :meth:`_update`."""
+    """Plots of one tab. A subclass names what it shows (:attr:`shows`, keys of
+    :data:`app.state.SHOWN`, and :attr:`own`, its own parameters) and draws in :meth:`_update`;
+    it is refreshed once per change of those values, while its tab is visible (a hidden tab
+    catches up when shown), and not at all when a change leaves them as they were drawn."""
 
     state = param.ClassSelector(class_=ExplorerState, doc="The session whose design this view plots.")
+    shows: tuple[str, ...] = ()
+    own: tuple[str, ...] = ()
 
     def __init__(self, state: ExplorerState, **params):
         self._shown = True
         self._stale = False
         self._mode = None
+        self._drawn: tuple | None = None  # the values drawn last
         self.dims: dict = {}
         super().__init__(state=state, **params)
+        state.param.watch(self._on_change, list(self.watched()))
+        if self.own:
+            self.param.watch(self._on_change, list(self.own))
+
+    @classmethod
+    def watched(cls) -> tuple[str, ...]:
+        """The state's parameters the view draws from (:data:`app.state.SHOWN`)."""
+        return tuple(name for key in cls.shows for name in SHOWN[key])
+
+    def values(self) -> tuple:
+        """The values the view draws from, now."""
+        return (*(getattr(self.state, n) for n in self.watched()), *(getattr(self, n) for n in self.own))
+
+    def _on_change(self, *_events):
+        self.changed()
+
+    def draw(self):
+        """Draw the view's current values (the first time, outside a held document: held, new panes
+        are laid out wrong)."""
+        self._drawn = self.values()
+        self._update()
 
     def dims_for(self, mode: str) -> dict:
         """The view's dimensions (:func:`app.plotting.style.dimensions`): kept while the mode is, new with
@@ -48,6 +85,12 @@ class PlotView(pn.viewable.Viewer):
             self.refresh()
 
     def refresh(self):
+        """Draw the current values, unless they are those drawn last (a change that reached the
+        view twice, or one that left its values as they were)."""
+        values = self.values()
+        if self._drawn is not None and len(values) == len(self._drawn) and all(map(_same, values, self._drawn)):
+            return
+        self._drawn = values
         update_or_keep(f"{type(self).__name__} kept its last plots", self._update)
 
     def _update(self):

@@ -12,7 +12,6 @@ from core.parameters import MODE, ROTATIONS, TRANSLATIONS
 from core.shape import long_shape_factor
 
 from .. import units
-from ..bands import BAND_PARAMETERS
 from ..curves import card_bands, card_sweeps, padded
 from ..inputs import FloatInput
 from ..live import LivePlot
@@ -36,6 +35,9 @@ drive in each (at the same equivalent strain, the loss factors are the same: one
 class CardView(PlotView):
     """The bushing card at the operating frequency."""
 
+    shows = ("design", "frequency", "bands")
+    own = ("displacement_mm", "angle_rad")
+
     displacement_mm = param.Number(0.1, bounds=(1e-6, 100.0),
                                    label=f"Displacement amplitude ({TRANSLATION.amplitude.display})")
     angle_rad = param.Number(0.01, bounds=(1e-7, 1.0), label=f"Angle amplitude ({ROTATION.amplitude.display})")
@@ -49,12 +51,7 @@ class CardView(PlotView):
         self.table = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.dims = card_dimensions()
         self.plots: LivePlot | None = None
-        self._update()
-
-    @param.depends("state.design", "state.errors", "state.frequency_hz", "displacement_mm", "angle_rad",
-                   *(f"state.{n}" for n in BAND_PARAMETERS), watch=True)
-    def _on_state(self):
-        self.changed()
+        self.draw()
 
     def frame(self, which: str):
         return self.plots.current[WHICH.index(which)]

@@ -7,13 +7,10 @@ from __future__ import annotations
 import holoviews as hv
 import numpy as np
 import panel as pn
-import param
 
 from .. import curves, units
-from ..bands import BAND_PARAMETERS
 from ..live import LivePlot
-from ..plotting.explorer import explorer_labels, explorer_overlays, on_ranges, sweep_curves
-from ..plotting.style import ranged
+from ..plotting.explorer import explorer_overlays
 from ..state import ExplorerState
 from ..views import PlotView
 
@@ -25,21 +22,16 @@ class ExplorerPlots(PlotView):
     """Loop, |K| and loss factor against frequency and amplitude, linked by the operating
     point: a tap on a frequency plot sets the frequency, on an amplitude plot the amplitude."""
 
+    shows = ("design", "frequency", "amplitude", "sweep range", "reference", "measured", "bands")
+
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
         self.summary = pn.pane.HTML("", sizing_mode="stretch_width", css_classes=["operating-point"],
                                     margin=(0, 10))
         self.loop: LivePlot | None = None
         self.grid: LivePlot | None = None
-        self._sweeps, self._sweeps_key = {}, None
         self._band_cache: dict = {}  # the last few tolerance bands (app.curves.operating_bands)
-        self._update()  # built outside a held document: held, the new panes are laid out wrong
-
-    @param.depends("state.design", "state.freq_min", "state.freq_max", "state.errors", "state.frequency_hz",
-                   "state.amplitude", "state.reference", "state.measured", "state.measured_loop",
-                   *(f"state.{n}" for n in BAND_PARAMETERS), watch=True)
-    def _on_state(self):
-        self.changed()
+        self.draw()
 
     def frame(self, key) -> hv.Overlay:
         """What a plot shows now: ``"loop"`` or a (quantity, against) pair of :data:`GRID`."""
@@ -52,16 +44,7 @@ class ExplorerPlots(PlotView):
             design, f, x, np.linspace(*freq_range, 120), curves.amplitude_grid(design), tol, self._band_cache))
         data = curves.explorer_data(design, f, x, freq_range=freq_range, reference=s.reference,
                                     measured=s.measured, measured_loop=s.measured_loop, bands=bands)
-        self.dims_for(data.mode)  # new units: new axes
-        key = (s.design, s.freq_range)
-        if key != self._sweeps_key:  # the sweeps change with the design, not the operating point
-            labels = explorer_labels(data)
-            self._sweeps = {k: sweep_curves(*k, data.sweeps[k[1]], self.dims, labels[k[1]]) for k in GRID}
-            self._sweeps_key = key
-        dims = ranged(self.dims, data.ranges)
-        # the kept sweeps on this update's ranges, kept so: re-ranged once per change of ranges
-        self._sweeps = {k: on_ranges(items, dims, *k) for k, items in self._sweeps.items()}
-        overlays = explorer_overlays(data, dims, self._sweeps)
+        overlays = explorer_overlays(data, self.dims_for(data.mode))
         grid = [overlays[k] for k in GRID]
         if self.grid is None:
             taps = {i: self.tap_frequency if against == "frequency" else self.tap_amplitude
@@ -103,23 +86,32 @@ def pct(value: float) -> str:
     return f"{0.0 if abs(value) < 0.005 else value:+.2f} %"
 
 
-class CompareView(pn.viewable.Viewer):
+class CompareView(PlotView):
     """Pin the current design as a reference; show the differences in %."""
 
+    shows = ("design", "frequency", "amplitude", "sweep range", "reference")
+
     def __init__(self, state: ExplorerState, **params):
-        super().__init__(**params)
-        self.state = state
+        super().__init__(state, **params)
         self.pin = pn.widgets.Button(label="Pin as reference", color="primary", description="Keep this design to compare the next ones with it (dashed curves).")
         self.clear = pn.widgets.Button(label="Clear reference", color="light")
         self.pin.on_click(lambda _e: state.pin_reference())
         self.clear.on_click(lambda _e: state.clear_reference())
+        self.text = pn.pane.Markdown("", sizing_mode="stretch_width", css_classes=["comparison"])
+        self.draw()
 
-    def table(self, reference, design, f, x, errors):
-        c = curves.comparison(design, reference, f, x, self.state.freq_range)
-        if c is None:
+    def _update(self):
+        self.text.object = self.table()
+
+    def table(self) -> str:
+        """The comparison with the pinned reference (Markdown), or what to do to see one."""
+        s = self.state
+        design, reference, f, x = s.design, s.reference, s.frequency_hz, s.amplitude
+        if reference is None:
             return "_No reference pinned: press **Pin as reference**, then change the design._"
         if reference.mode != design.mode:
             return "_The reference is in another mode; switch back to compare._"
+        c = curves.comparison(design, reference, f, x, s.freq_range)
         unit = units.stiffness_unit(design.mode)
         (m_now, m_ref, m_d), (e_now, e_ref, e_d) = c["operating"]["magnitude"], c["operating"]["loss_factor"]
         return (
@@ -132,10 +124,4 @@ class CompareView(pn.viewable.Viewer):
         )
 
     def __panel__(self):
-        s = self.state.param
-        return pn.Column(
-            pn.Row(self.pin, self.clear),
-            pn.pane.Markdown(pn.bind(self.table, s.reference, s.design, s.frequency_hz, s.amplitude, s.errors),
-                             sizing_mode="stretch_width", css_classes=["comparison"]),
-            sizing_mode="stretch_width",
-        )
+        return pn.Column(pn.Row(self.pin, self.clear), self.text, sizing_mode="stretch_width")

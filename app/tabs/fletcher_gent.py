@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import numpy as np
 import panel as pn
-import param
 
 from ..curves import amplitude_bounds, amplitude_grid, branch_breakdown, hysteresis_loop, padded
 from ..live import LivePlot, update_or_keep
@@ -33,6 +32,8 @@ WHICH = ("real", "loss")
 class TeachingView(PlotView):
     """The Fletcher–Gent effect branch by branch, and the loop changing as amplitude sweeps."""
 
+    shows = ("design", "frequency", "amplitude")
+
     FRAMES = 48
 
     def __init__(self, state: ExplorerState, **params):
@@ -46,11 +47,7 @@ class TeachingView(PlotView):
         self.branches: LivePlot | None = None
         self.loop: LivePlot | None = None
         self.player.param.watch(lambda _e: self._frame(), "value")
-        self._update()  # built outside a held document: held, the new panes are laid out wrong
-
-    @param.depends("state.design", "state.errors", "state.frequency_hz", "state.amplitude", watch=True)
-    def _on_state(self):
-        self.changed()
+        self.draw()
 
     def frame(self, which: str):
         """What a plot shows now: "real", "loss" (the branches) or "loop" (the loop's shape)."""

@@ -9,7 +9,6 @@ import logging
 
 import numpy as np
 import panel as pn
-import param
 
 from core import PAPER_B
 from core.parameters import BY_NAME, MATERIAL
@@ -34,6 +33,8 @@ FITTED = " and ".join([", ".join(BY_NAME[p].symbol for p in MATERIAL[:-1]), BY_N
 
 class MeasuredView(PlotView):
     """Upload, fit and residuals."""
+
+    shows = ("design", "measured", "data message", "fit")
 
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
@@ -68,12 +69,7 @@ class MeasuredView(PlotView):
         self.prediction = pn.pane.HoloViews(None, sizing_mode="stretch_width", visible=False, linked_axes=False)
         self._prediction_key = None
         self.residuals: LivePlot | None = None
-        self._update()  # built outside a held document: held, the new panes are laid out wrong
-
-    @param.depends("state.design", "state.measured", "state.measured_loop", "state.fit_result",
-                   "state.data_message", "state.fit_method", watch=True)
-    def _on_state(self):
-        self.changed()
+        self.draw()
 
     def frame(self, quantity: str, against: str):
         """What a residual plot shows now (``quantity`` "magnitude" or "loss")."""

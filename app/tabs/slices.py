@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import panel as pn
-import param
 
 from ..curves import amplitude_grid, padded, slice_comparison
 from ..live import LivePlot
@@ -20,17 +19,15 @@ WHICH = ("magnitude", "magnitude_diff_pct", "loss_factor")
 class SlicesView(PlotView):
     """One equivalent modulus against 2 and 3 slices and the continuum, at the loop frequency."""
 
+    shows = ("design", "frequency", "amplitude")
+
     NAMES = SLICE_NAMES
 
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state, **params)
         self.table = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.plots: LivePlot | None = None
-        self._update()  # built outside a held document: held, the new panes are laid out wrong
-
-    @param.depends("state.design", "state.errors", "state.frequency_hz", "state.amplitude", watch=True)
-    def _on_state(self):
-        self.changed()
+        self.draw()
 
     def frame(self, which: str):
         return self.plots.current[WHICH.index(which)]

@@ -58,6 +58,8 @@ the targets file to repeat it there.
 class WhatIfView(PlotView):
     """Tolerances, sensitivities, targets."""
 
+    shows = ("design", "frequency", "amplitude")
+
     target_magnitude = param.Number(default=None, allow_None=True, bounds=(0, None), label="|K| target")
     target_tolerance_pct = param.Number(default=1.0, bounds=(0.001, 50.0), label="Met within ± %")
     loss_factor_min = param.Number(default=None, allow_None=True, bounds=(0, 10), label="Loss factor at least")
@@ -106,7 +108,7 @@ class WhatIfView(PlotView):
         self.targets_file = pn.widgets.FileDownload(callback=self._targets_file, filename="bushing-targets.json",
                                                     label="Targets file (JSON)", width=200)
         self._on_band()
-        self._update()
+        self.draw()
 
     # ---- tolerances ------------------------------------------------------------------------------
 
@@ -149,9 +151,6 @@ class WhatIfView(PlotView):
 
     # ---- sensitivities ---------------------------------------------------------------------------
 
-    @param.depends("state.design", "state.errors", "state.frequency_hz", "state.amplitude", watch=True)
-    def _on_state(self):
-        self.changed()
 
     def sensitivities(self) -> dict:
         s = self.state
