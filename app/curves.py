@@ -248,6 +248,8 @@ class ExplorerData:
     """Everything the explorer's five plots show for one design and operating point, in
     display units. Built by :func:`explorer_data`."""
 
+    design: Design
+    freq_range: tuple[float, float]
     mode: str
     frequency_hz: float
     amplitude: float
@@ -338,7 +340,8 @@ def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq
                                     + ([loop_points["displacement"]] if loop_points else []))
     ranges["force"] = padded([lp["force"], lp["force_elastic"], lp["force_viscoelastic"], lp["force_friction"]]
                              + ([ref_loop["force"]] if ref_loop else []) + ([loop_points["force"]] if loop_points else []))
-    return ExplorerData(mode=mode, frequency_hz=frequency_hz, amplitude=amplitude, sweeps=sweeps,
+    return ExplorerData(design=design, freq_range=(float(freq_range[0]), float(freq_range[1])), mode=mode,
+                        frequency_hz=frequency_hz, amplitude=amplitude, sweeps=sweeps,
                         operating=operating, references=references, measured=points, loop=lp,
                         reference_loop=ref_loop, measured_loop=loop_points, ranges=ranges, bands=bands)
 

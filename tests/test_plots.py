@@ -134,18 +134,23 @@ def test_the_plots_draw_on_canvas_with_webgl_asked_for():
     assert len(figs) == 5 and {f.output_backend for f in figs} == {"canvas"}
 
 
-def test_the_explorer_s_plots_leave_the_sweep_curves_they_are_given_as_they_were():
-    """A builder of plots is a function of its arguments: sweep curves passed on other ranges are
-    drawn on the plot's (clones), and the caller's dict keeps its own curves."""
+def test_the_explorer_s_sweeps_are_built_once_per_design_sweep_range_and_axes():
+    """The sweep curves of a plot are a cached function of their values (explorer.sweep_layer):
+    moving the operating point along them finds the same curve objects (a live plot sends them
+    no data); another design builds new ones; each carries its plot's ranges."""
     from app import curves
 
-    dims = plots.dimensions("axial")
-    data = curves.explorer_data(PAPER_B, 10.0, 0.1)
-    labels = explorer.explorer_labels(data)
-    given = {k: explorer.sweep_curves(*k, data.sweeps[k[1]], dims, labels[k[1]]) for k in explorer.TITLES}
-    kept = {k: list(v) for k, v in given.items()}
-    out = explorer.explorer_overlays(data, dims, given)
-    assert set(given) == set(kept) and all(given[k][i] is kept[k][i] for k in kept for i in range(len(kept[k])))
-    drawn = out[("magnitude", "frequency")].get(0)
-    assert tuple(drawn.vdims[0].range) == tuple(data.ranges["magnitude"])
-    assert tuple(given[("magnitude", "frequency")][0].vdims[0].range) == (None, None)
+    def sweeps(design, f, x):
+        data = curves.explorer_data(design, f, x)
+        return data, [el for el in explorer.explorer_overlays(data)[("magnitude", "frequency")]
+                      if el.label.startswith("ε̂")]
+
+    data, first = sweeps(PAPER_B, 10.0, 0.1)
+    _, moved = sweeps(PAPER_B, 20.0, 0.11)
+    _, other = sweeps(PAPER_B.replace(length=0.05), 10.0, 0.1)
+    assert len(first) == len(curves.SWEEP_STRAINS) and all(a is b for a, b in zip(first, moved))
+    assert not any(a is b for a, b in zip(first, other))
+    assert tuple(first[0].vdims[0].range) == tuple(data.ranges["magnitude"])
+    k = stiffness(PAPER_B, data.sweeps["frequency"]["frequency_hz"],
+                  PAPER_B.drive(curves.SWEEP_STRAINS[0] * PAPER_B.material.friction_strain_half)).magnitude[0]
+    assert_allclose(first[0].dimension_values(1), k / 1e6, rtol=1e-12)

@@ -5,7 +5,10 @@ points, a tolerance band, the operating point's marker).
 
 from __future__ import annotations
 
+import functools
+
 import holoviews as hv
+import numpy as np
 
 from core import Design
 
@@ -87,39 +90,40 @@ def sweep_overlay(quantity: str, against: str, sweep_items: list, dims: dict, *,
     return overlay(items, TITLES[(quantity, against)], f"bushing-{quantity}-vs-{against}",
                    logx=against == "amplitude")
 
-def explorer_labels(data: curves.ExplorerData) -> dict:
-    """The legend entries of the sweeps: equivalent strains against frequency, frequencies
-    against amplitude."""
-    return {"frequency": [strain_label(r) for r in curves.SWEEP_STRAINS],
-            "amplitude": [sweep_label(v, "Hz") for v in data.sweeps["amplitude"]["frequency_hz"]]}
+@functools.lru_cache(maxsize=64)
+def sweep_layer(design: Design, freq_range: tuple[float, float], quantity: str, against: str,
+                ranges: tuple, n_freq: int = 120, n_amp: int = 120) -> tuple:
+    """The sweep curves of one plot of ``design`` (:func:`sweep_curves`: |K| or the loss factor
+    against frequency at the sweep amplitudes, or against amplitude at the sweep frequencies) on
+    axes of ``ranges`` ((x start, end), (y start, end), display units).
 
-def on_ranges(items: list, dims: dict, quantity: str, against: str) -> list:
-    """A plot's sweep curves on the ranges of ``dims``: ``items`` themselves where they are on them,
-    else new curves of the same data. Every element of a plot carries its ranges: one without
-    would cost HoloViews a look at its data on every update (measured: about 5 ms per change)."""
-    if all(tuple(el.kdims[0].range) == tuple(dims[against].range)
-           and tuple(el.vdims[0].range) == tuple(dims[quantity].range) for el in items):
-        return items
-    return [el.clone(kdims=[dims[against]], vdims=[dims[quantity]]) for el in items]
+    Cached on these values: they change with the design, the sweep range and the axes, not with
+    the operating point, and a change of the operating point finds the same curves (objects a
+    live plot sends no data for)."""
+    dims = ranged(dimensions(design.mode), {against: ranges[0], quantity: ranges[1]})
+    if against == "frequency":
+        sweep = curves.frequency_sweep(design, np.linspace(*freq_range, n_freq), curves.sweep_amplitudes(design))
+        labels = [strain_label(r) for r in curves.SWEEP_STRAINS]
+    else:
+        sweep = curves.amplitude_sweep(design, curves.amplitude_grid(design, n_amp),
+                                       curves.sweep_frequencies(*freq_range))
+        labels = [sweep_label(v, "Hz") for v in sweep["frequency_hz"]]
+    return tuple(sweep_curves(quantity, against, sweep, dims, labels))
 
-def explorer_overlays(data: curves.ExplorerData, dims: dict | None = None, sweep_items: dict | None = None) -> dict:
+
+def explorer_overlays(data: curves.ExplorerData, dims: dict | None = None) -> dict:
     """The five plots of ``data`` (:func:`app.curves.explorer_data`): ``"loop"`` and one per (quantity,
     against) of :data:`TITLES`. ``dims`` are the dimensions to draw on (a live view passes its
     own, so that its plots keep their axes); the plots carry the data's ranges on clones of them
-    (:func:`app.plotting.style.ranged`), ``dims`` are left as they are. ``sweep_items`` may give the
-    sweep curves of each plot, already built (a live view keeps them while only the operating
-    point moves); those on other ranges are put on the plot's (new curves with the same data).
-    ``sweep_items`` itself is not changed (a live view keeps its own on the ranges,
-    :func:`on_ranges`)."""
+    (:func:`app.plotting.style.ranged`), ``dims`` are left as they are. The sweeps' curves come
+    from :func:`sweep_layer` (the same objects while the design, the sweep range and the axes
+    are)."""
     dims = ranged(dims if dims is not None else dimensions(data.mode), data.ranges)
     out = {"loop": loop_overlay(data.loop, dims, reference=data.reference_loop, measured=data.measured_loop)}
-    labels = explorer_labels(data)
+    n_freq, n_amp = (len(data.sweeps[k][c]) for k, c in (("frequency", "frequency_hz"), ("amplitude", "amplitude")))
     for (quantity, against) in TITLES:
-        items = (sweep_items or {}).get((quantity, against))
-        if items is None:
-            items = sweep_curves(quantity, against, data.sweeps[against], dims, labels[against])
-        else:
-            items = on_ranges(items, dims, quantity, against)
+        ranges = (tuple(dims[against].range), tuple(dims[quantity].range))
+        items = sweep_layer(data.design, data.freq_range, quantity, against, ranges, n_freq, n_amp)
         out[(quantity, against)] = sweep_overlay(
             quantity, against, items, dims, operating=data.operating[against],
             at=data.frequency_hz if against == "frequency" else data.amplitude,
@@ -127,6 +131,7 @@ def explorer_overlays(data: curves.ExplorerData, dims: dict | None = None, sweep
             band=data.bands[against][quantity] if data.bands else None,
             band_name=band_label(data.bands["point"]["percentiles"]) if data.bands else "")
     return out
+
 
 def explorer_plots(design: Design, frequency_hz: float = 10.0, amplitude: float | None = None, *,
                    width: int | None = 600, **kwargs) -> hv.Layout:
