@@ -12,7 +12,7 @@ from . import patches
 from .diagnosis_state import DiagnosisState
 from .export import ExportView
 from .inputs import DesignInputs, status_banner
-from .link import URL_NAMES, ShareLink
+from .link import URL_DELAY_MS, UrlLink
 from .state import ExplorerState
 from .tabs.about import ABOUT
 from .tabs.every_direction import CardView
@@ -29,8 +29,6 @@ pn.extension("filedropper", throttled=False)  # the upload areas (app.uploads) a
 
 TITLE = "Bushing Explorer"
 
-
-URL_DELAY_MS = 300
 # uploads travel in chunks of app.uploads.CHUNK_BYTES (base64 in JSON: 4/3 of it); no other
 # message comes near this
 UPLOAD_MESSAGE_BYTES = 16 * 1024 * 1024
@@ -110,44 +108,12 @@ class App(pn.viewable.Viewer):
                 view.show(index == active)
 
     def sync_url(self, delay_ms: int = URL_DELAY_MS):
-        """Put the whole design in the URL, and read one from it (a shared link)."""
+        """Put the whole design in the URL, and read one from it (a shared link, the back
+        button): :class:`app.link.UrlLink` on the session's Location."""
         location = pn.state.location
         if location is None:
             return
-        self.link = ShareLink(**{name: getattr(self.state, name) for name in URL_NAMES})
-        self._copying = False
-        self._pending = None
-        self.link.param.watch(self._from_link, list(URL_NAMES))
-        location.sync(self.link, URL_NAMES, on_error=self.state.apply_url_values)
-        self.state.param.watch(lambda *_events: self._schedule_link(delay_ms), list(URL_NAMES))
-
-    def _from_link(self, *events):
-        if self._copying:
-            return
-        values = {e.name: e.new for e in events}
-        try:
-            self.state.param.update(values)
-        except Exception:  # noqa: BLE001 - one bad value: apply the others, say which
-            self.state.apply_url_values(values)
-
-    def _schedule_link(self, delay_ms: int):
-        doc = pn.state.curdoc
-        if doc is None:
-            return self._to_link()
-        if self._pending is not None:
-            try:
-                doc.remove_timeout_callback(self._pending)
-            except ValueError:
-                pass  # it has just run
-        self._pending = doc.add_timeout_callback(self._to_link, delay_ms)
-
-    def _to_link(self):
-        self._pending = None
-        self._copying = True
-        try:
-            self.link.param.update({name: getattr(self.state, name) for name in URL_NAMES})
-        finally:
-            self._copying = False
+        self.link = UrlLink(self.state, location, pn.state.curdoc, delay_ms)
 
     def template(self):
         template = pn.template.BootstrapTemplate(

@@ -97,12 +97,12 @@ def test_the_sensitivity_bars_follow_the_operating_point(app):
 
 def test_the_design_form_finds_a_design_and_the_explorer_takes_it(app):
     v = app.whatif
-    v.param.update(target_magnitude=4.5, loss_factor_min=0.12, b_max_mm=40.0, length_max_mm=100.0)
+    v.form.param.update(target_magnitude=4.5, loss_factor_min=0.12, b_max_mm=40.0, length_max_mm=100.0)
     spec = json.loads(v._targets_file().getvalue())
     assert spec["targets"][0]["magnitude"] == pytest.approx(4.5e6) and spec["fixed"] == ["inner_radius"]
-    v.run()
-    assert v.found.feasible and "meets every target" in v.result.object
-    v.use_solution(0)
+    v.form.run()
+    assert v.form.found.feasible and "meets every target" in v.result.object
+    v.form.use_solution(0)
     d = app.state.design
     assert d.geometry.inner_radius == PAPER_B.geometry.inner_radius and d.geometry.outer_radius <= 0.040 + 1e-12
     assert abs(complex(stiffness_points(d, 10.0, 1e-4))) == pytest.approx(4.5e6, rel=1e-6)
@@ -111,11 +111,11 @@ def test_the_design_form_finds_a_design_and_the_explorer_takes_it(app):
 
 def test_the_design_form_says_when_targets_cannot_be_met(app):
     v = app.whatif
-    v.run()
+    v.form.run()
     assert "give at least one target" in v.result.object
-    v.param.update(target_magnitude=400.0, b_max_mm=40.0, length_max_mm=100.0, thickness_min_mm=5.0)
-    v.run()
-    assert not v.found.feasible and "cannot be met" in v.result.object and "closest" in v.result.object
+    v.form.param.update(target_magnitude=400.0, b_max_mm=40.0, length_max_mm=100.0, thickness_min_mm=5.0)
+    v.form.run()
+    assert not v.form.found.feasible and "cannot be met" in v.result.object and "closest" in v.result.object
     assert v.use.label == "Take the closest into the explorer"
 
 
@@ -167,3 +167,39 @@ def test_no_number_field_of_any_tab_waits_before_it_sends_its_value(app):
     assert len(found) > 20  # the design's fields, the tolerances, the targets, the card's drive …
     late = [f"{type(w).__name__} {w.name!r}" for w in found if "value" not in type(w)._priority_changes]
     assert not late, late
+
+
+def test_the_targets_form_is_its_own_state_and_its_file_says_every_field_in_si(app):
+    """The form (app.targets_form, no Panel) holds the fields; the tab's download is its file:
+    torsion at 25 Hz and 0.013 rad, every field given, in the SI units docs/files.md states."""
+    import subprocess
+    import sys
+
+    from core.io.targets import problem_from_dict
+
+    code = "import sys, app.targets_form; assert not {'panel', 'bokeh', 'holoviews'} & set(sys.modules)"
+    subprocess.run([sys.executable, "-c", code], check=True)
+    app.state.mode = "torsion"
+    app.state.param.update(amplitude=0.013, frequency_hz=25.0)
+    v = app.whatif
+    v.form.param.update(target_magnitude=4.5, target_tolerance_pct=2.0, loss_factor_min=0.12, ratio_min=1.5,
+                        b_max_mm=40.0, length_max_mm=100.0, thickness_min_mm=5.0, hold_inner=False,
+                        mu_min_mpa=1.0, mu_max_mpa=3.0)
+    text = v._targets_file().getvalue()
+    assert text == json.dumps(json.loads(text), indent=2) + "\n"  # two-space JSON, one final newline
+    spec = json.loads(text)
+    assert spec.pop("design") == app.state.design.to_dict()
+    at = {"frequency_hz": 25.0, "amplitude": pytest.approx(0.013, rel=1e-12)}
+    assert spec == {
+        "targets": [{"mode": "torsion", **at, "magnitude": pytest.approx(4.5, rel=1e-12), "tolerance": 0.02},  # N·m/rad
+                    {"mode": "torsion", **at, "loss_factor": {"min": 0.12}},
+                    # a rotation's drive is no translation's: the ratio is taken at 0.1 mm
+                    {"ratio": ["radial", "axial"], "frequency_hz": 25.0, "amplitude": 1e-4, "magnitude": {"min": 1.5}}],
+        "limits": {"outer_radius": {"max": pytest.approx(0.040, rel=1e-12)},
+                   "length": {"max": pytest.approx(0.100, rel=1e-12)},
+                   "thickness": {"min": pytest.approx(0.005, rel=1e-12)}},
+        "solutions": 5,  # no "fixed": the inner radius may change
+        "free_material": {"shear_modulus": {"min": pytest.approx(1e6, rel=1e-12), "max": pytest.approx(3e6, rel=1e-12)}}}
+    assert len(problem_from_dict(json.loads(text)).targets) == 3  # the command line's reader takes it
+    with pytest.raises(ValueError):
+        v.form.target_tolerance_pct = 60.0  # the field's bounds, as the tab's input had them

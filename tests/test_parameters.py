@@ -159,7 +159,7 @@ def test_each_material_parameter_moves_its_own_branch_of_the_modulus_only():
 # conditions of each mode, the design search's default limits of each size
 KEPT = {("core/shape.py", "_HELD"), ("core/io/targets.py", "DEFAULT_LIMITS"),
         # and the what-ifs' radial/axial ratio: one pair of modes, in the order of the quotient
-        ("app/tabs/what_ifs.py", "STIFFNESS_RATIO")}
+        ("app/targets_form.py", "STIFFNESS_RATIO")}
 
 
 def _typed_out(node: ast.AST) -> bool:

@@ -3,19 +3,14 @@ sensitivities at the operating point, and designs found from target stiffnesses.
 
 from __future__ import annotations
 
-import asyncio
 import io
-import json
-import logging
 
 import holoviews as hv
 import panel as pn
 import param
 
-from core.io.targets import problem_from_dict
-from core.parameters import BY_NAME, GEOMETRY, NAMES, TRANSLATIONS
+from core.parameters import BY_NAME, GEOMETRY, NAMES
 from core.whatif.sensitivity import elasticities, ranked, sentence
-from core.whatif.target import Found, TargetError, solve
 from core.whatif.tolerance import ToleranceError
 
 from .. import units
@@ -23,13 +18,10 @@ from ..inputs import FloatInput, IntInput
 from ..live import LivePlot
 from ..plotting.what_ifs import sensitivity_bars
 from ..state import ExplorerState
+from ..targets_form import TargetsForm
 from ..views import PlotView
 
-log = logging.getLogger("bushing.app")
-
-A, B, L, MU = (BY_NAME[n] for n in (*GEOMETRY, "shear_modulus"))
-# the what-if's ratio target: radial over axial |K| (a pair chosen by meaning, not a list of modes)
-STIFFNESS_RATIO = ("radial", "axial")
+A, _B, L, MU = (BY_NAME[n] for n in (*GEOMETRY, "shear_modulus"))
 # a found design's columns: its geometry and µ (what a search changes), each to its digits
 FOUND_COLUMNS = {**{n: ".3f" for n in GEOMETRY}, L.name: ".2f", MU.name: ".4g"}
 
@@ -60,25 +52,6 @@ class WhatIfView(PlotView):
 
     shows = ("design", "frequency", "amplitude")
 
-    target_magnitude = param.Number(default=None, allow_None=True, bounds=(0, None), label="|K| target")
-    target_tolerance_pct = param.Number(default=1.0, bounds=(0.001, 50.0), label="Met within ± %")
-    loss_factor_min = param.Number(default=None, allow_None=True, bounds=(0, 10), label="Loss factor at least")
-    ratio_min = param.Number(default=None, allow_None=True, bounds=(0, None), label="Radial / axial at least")
-    b_max_mm = param.Number(default=None, allow_None=True, bounds=(0, None),
-                            label=f"{B.symbol} at most ({B.unit.display})")
-    length_max_mm = param.Number(default=None, allow_None=True, bounds=(0, None),
-                                 label=f"{L.symbol} at most ({L.unit.display})")
-    thickness_min_mm = param.Number(default=2.0, allow_None=True, bounds=(0, None),
-                                    label=f"Rubber {B.symbol} − {A.symbol} at least ({B.unit.display})")
-    hold_inner = param.Boolean(default=True, label="Keep the inner radius (the shaft)")
-    mu_min_mpa = param.Number(default=None, allow_None=True, bounds=(0, None),
-                              label=f"{MU.symbol} from ({MU.unit.display})")
-    mu_max_mpa = param.Number(default=None, allow_None=True, bounds=(0, None),
-                              label=f"{MU.symbol} to ({MU.unit.display})")
-    running = param.Boolean(default=False)
-    found = param.Parameter(default=None, doc="The last search's core.whatif.target.Found.")
-    message = param.String(default="")
-
     def __init__(self, state: ExplorerState, **params):
         self._showing = False
         super().__init__(state, **params)
@@ -99,11 +72,13 @@ class WhatIfView(PlotView):
         self.band_status = pn.pane.HTML("", sizing_mode="stretch_width")
         self.sentence = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.bars: LivePlot | None = None
+        self.form = TargetsForm(state)
+        self.form.param.watch(self._show_found, ["found", "message"])
         self.find = pn.widgets.Button(label="Find designs", color="primary", width=160)
         self.find.on_click(self._run)
         self.solutions = pn.widgets.Select(label="Solution", options={}, width=420, visible=False)
         self.use = pn.widgets.Button(label="Take it into the explorer", color="success", visible=False)
-        self.use.on_click(lambda _e: self.use_solution())
+        self.use.on_click(lambda _e: self.form.use_solution(self.solutions.value))
         self.result = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.targets_file = pn.widgets.FileDownload(callback=self._targets_file, filename="bushing-targets.json",
                                                     label="Targets file (JSON)", width=200)
@@ -174,83 +149,28 @@ class WhatIfView(PlotView):
 
     # ---- targets ---------------------------------------------------------------------------------
 
-    def spec(self) -> dict:
-        """The targets file (docs/files.md) of the form: targets at the explorer's operating point."""
-        s = self.state
-        design = s.design
-        mode, f = design.mode, s.frequency_hz
-        x = float(units.to_si_amplitude(s.amplitude, mode))
-        targets = []
-        if self.target_magnitude:
-            targets.append({"mode": mode, "frequency_hz": f, "amplitude": x,
-                            "magnitude": float(units.to_si_stiffness(self.target_magnitude, mode)),
-                            "tolerance": self.target_tolerance_pct / 100.0})
-        if self.loss_factor_min:
-            targets.append({"mode": mode, "frequency_hz": f, "amplitude": x, "loss_factor": {"min": self.loss_factor_min}})
-        if self.ratio_min:
-            drive = x if mode in TRANSLATIONS else 1e-4  # a translation's drive: the operating one, or 0.1 mm
-            targets.append({"ratio": list(STIFFNESS_RATIO), "frequency_hz": f, "amplitude": drive,
-                            "magnitude": {"min": self.ratio_min}})
-        limits = {}
-        if self.b_max_mm:
-            limits["outer_radius"] = {"max": float(B.unit.to_si(self.b_max_mm))}
-        if self.length_max_mm:
-            limits["length"] = {"max": float(L.unit.to_si(self.length_max_mm))}
-        if self.thickness_min_mm:
-            limits["thickness"] = {"min": float(B.unit.to_si(self.thickness_min_mm))}
-        out = {"design": design.to_dict(), "targets": targets, "limits": limits, "solutions": 5}
-        if self.hold_inner:
-            out["fixed"] = ["inner_radius"]
-        if self.mu_min_mpa or self.mu_max_mpa:
-            out["free_material"] = {MU.name: {k: float(MU.unit.to_si(v)) for k, v in (("min", self.mu_min_mpa),
-                                                                                  ("max", self.mu_max_mpa)) if v}}
-        return out
-
     def _targets_file(self):
-        return io.StringIO(json.dumps(self.spec(), indent=2) + "\n")
-
-    def compute(self) -> Found:
-        """The search (pure: safe in a worker thread)."""
-        spec = self.spec()
-        if not spec["targets"]:
-            raise TargetError("give at least one target: |K|, a least loss factor or a radial/axial ratio")
-        return solve(problem_from_dict(spec))
+        return io.StringIO(self.form.targets_text())
 
     async def _run(self, _event):
-        if self.running:
-            return
-        self.param.update(running=True, message="")
+        if self.form.running:
+            return  # one search at a time: the button shows the running one
         self.find.loading = True
         try:
-            found = await asyncio.to_thread(self.compute)
-        except (TargetError, ValueError) as exc:
-            self.param.update(found=None, message=str(exc))
-        except Exception as exc:  # noqa: BLE001 - never a traceback in the page
-            log.warning("design search failed: %s: %s", type(exc).__name__, exc)
-            self.param.update(found=None, message=f"The search failed ({type(exc).__name__}): {exc}")
-        else:
-            self.param.update(found=found, message="")
+            await self.form.search()
         finally:
-            self.running = False
             self.find.loading = False
 
-    def run(self):
-        """The search, on this thread (tests and scripts)."""
-        try:
-            self.param.update(found=self.compute(), message="")
-        except (TargetError, ValueError) as exc:
-            self.param.update(found=None, message=str(exc))
-
-    @param.depends("found", "message", watch=True)
-    def _show_found(self):
-        found = self.found
+    def _show_found(self, *_events):
+        found = self.form.found
         if found is None:
-            self.result.object = f"**Cannot search**: {self.message}" if self.message else ""
+            message = self.form.message
+            self.result.object = f"**Cannot search**: {message}" if message else ""
             self.solutions.visible = self.use.visible = False
             return
         mode = found.problem.start.mode
         lines = [f"**{found.statement}** ({found.seconds:.2f} s)"]
-        rows = found.solutions or ([found.closest] if found.closest is not None else [])
+        rows = self.form.rows()
         if rows:
             targets = found.problem.targets
             header = [f"{BY_NAME[n].symbol} ({BY_NAME[n].unit.display})" for n in FOUND_COLUMNS]
@@ -269,26 +189,16 @@ class WhatIfView(PlotView):
         self.solutions.visible = self.use.visible = bool(rows)
         self.use.label = "Take it into the explorer" if found.solutions else "Take the closest into the explorer"
 
-    def use_solution(self, index: int | None = None):
-        """Take a found design into the explorer (the operating point kept)."""
-        found = self.found
-        if found is None:
-            return
-        rows = found.solutions or [found.closest]
-        i = self.solutions.value if index is None else index
-        design = rows[int(i or 0)].design
-        self.state.adopt(design.replace(name=f"{self.state.design.name or 'Design'} (from targets)"))
-
     def __panel__(self):
         w = FloatInput.from_param
         tol_grid = pn.GridBox(*self.tolerance_inputs.values(), ncols=4, sizing_mode="stretch_width")
         form = pn.Column(
-            pn.Row(w(self.param.target_magnitude, width=150), w(self.param.target_tolerance_pct, width=120),
-                   w(self.param.loss_factor_min, width=150), w(self.param.ratio_min, width=150)),
-            pn.Row(w(self.param.b_max_mm, width=150), w(self.param.length_max_mm, width=150),
-                   w(self.param.thickness_min_mm, width=170),
-                   pn.widgets.Checkbox.from_param(self.param.hold_inner, margin=(28, 10))),
-            pn.Row(w(self.param.mu_min_mpa, width=150), w(self.param.mu_max_mpa, width=150),
+            pn.Row(w(self.form.param.target_magnitude, width=150), w(self.form.param.target_tolerance_pct, width=120),
+                   w(self.form.param.loss_factor_min, width=150), w(self.form.param.ratio_min, width=150)),
+            pn.Row(w(self.form.param.b_max_mm, width=150), w(self.form.param.length_max_mm, width=150),
+                   w(self.form.param.thickness_min_mm, width=170),
+                   pn.widgets.Checkbox.from_param(self.form.param.hold_inner, margin=(28, 10))),
+            pn.Row(w(self.form.param.mu_min_mpa, width=150), w(self.form.param.mu_max_mpa, width=150),
                    pn.pane.HTML("<i>A µ range lets the compound vary too.</i>", margin=(28, 10))),
             pn.Row(self.find, self.targets_file),
             self.result, pn.Row(self.solutions, self.use), sizing_mode="stretch_width")
