@@ -17,8 +17,12 @@ from core.identify.fit import FitResult, fit_global, fit_two_step, predicted, se
 
 from .state import ExplorerState, measured_amplitudes
 
-# the session's data a fit is made on: a change of either forgets the fit
+# the session's data a fit is made on (ExplorerState's parameters): a change of either forgets the fit
 FIT_DATA = ("measured", "measured_loop")
+# what a view that shows the fit (or a band from its covariance) depends on, as a view with a
+# ``state`` and a ``fit`` names it in @param.depends: the fit, and the data (the fit is forgotten
+# silently when they change, :meth:`FitState._forget`)
+FIT_DEPENDS = ("fit.fit_result", *(f"state.{n}" for n in FIT_DATA))
 
 
 class FitState(param.Parameterized):

@@ -14,7 +14,7 @@ from core.shape import long_shape_factor
 from .. import units
 from ..bands import BAND_INPUTS, band_tolerances, banded
 from ..curves import card_bands, card_sweeps, padded
-from ..fit_state import FIT_DATA, FitState
+from ..fit_state import FIT_DEPENDS, FitState
 from ..inputs import FloatInput
 from ..live import LivePlot
 from ..plotting.every_direction import card_dimensions, card_overlays
@@ -55,8 +55,7 @@ class CardView(PlotView):
         self._update()
 
     @param.depends("state.design", "state.errors", "state.frequency_hz", "displacement_mm", "angle_rad",
-                   *(f"state.{n}" for n in BAND_INPUTS), "fit.fit_result", *(f"state.{n}" for n in FIT_DATA),
-                   watch=True)
+                   *(f"state.{n}" for n in BAND_INPUTS), *FIT_DEPENDS, watch=True)
     def _on_state(self):
         self.changed()
 

@@ -10,7 +10,7 @@ import param
 
 from .. import curves, units
 from ..bands import BAND_INPUTS, band_tolerances, banded
-from ..fit_state import FIT_DATA, FitState
+from ..fit_state import FIT_DEPENDS, FitState
 from ..live import LivePlot
 from ..plotting.explorer import explorer_labels, explorer_overlays, on_ranges, sweep_curves
 from ..plotting.style import ranged
@@ -37,8 +37,8 @@ class ExplorerPlots(PlotView):
         self._update()  # built outside a held document: held, the new panes are laid out wrong
 
     @param.depends("state.design", "state.freq_min", "state.freq_max", "state.errors", "state.frequency_hz",
-                   "state.amplitude", "state.reference", *(f"state.{n}" for n in FIT_DATA),
-                   *(f"state.{n}" for n in BAND_INPUTS), "fit.fit_result", watch=True)
+                   "state.amplitude", "state.reference",
+                   *(f"state.{n}" for n in BAND_INPUTS), *FIT_DEPENDS, watch=True)
     def _on_state(self):
         self.changed()
 

@@ -18,7 +18,7 @@ from core.synthetic import paper_b_example
 
 from .. import curves, units
 from ..curves import padded
-from ..fit_state import FIT_DATA, FitState
+from ..fit_state import FIT_DEPENDS, FitState
 from ..live import LivePlot
 from ..plotting.measured_data_and_fit import prediction_overlay, residual_overlays
 from ..plotting.style import ranged
@@ -75,7 +75,7 @@ class MeasuredView(PlotView):
         self._show_prediction()
         self._update()  # built outside a held document: held, the new panes are laid out wrong
 
-    @param.depends("state.design", *(f"state.{n}" for n in FIT_DATA), "fit.fit_result", "fit.fit_method", watch=True)
+    @param.depends("state.design", *FIT_DEPENDS, "fit.fit_method", watch=True)
     def _on_state(self):
         self.changed()
 
@@ -85,7 +85,7 @@ class MeasuredView(PlotView):
         m = self.state.data_message
         self.message.object = f'<div class="data-error" style="color:#b03a2e">⚠ {m}</div>' if m else ""
 
-    @param.depends("fit.fit_result", *(f"state.{n}" for n in FIT_DATA), watch=True)
+    @param.depends(*FIT_DEPENDS, watch=True)
     def _show_prediction(self):
         """A fit on a subset against every measured row: a function of the fit and the data only
         (not of the design shown), so drawn when either changes."""

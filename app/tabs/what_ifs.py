@@ -20,7 +20,7 @@ from core.whatif.tolerance import ToleranceError
 
 from .. import curves, units
 from ..bands import BAND_INPUTS, band_tolerances, banded
-from ..fit_state import FIT_DATA, FitState
+from ..fit_state import FIT_DEPENDS, FitState
 from ..inputs import FloatInput, IntInput
 from ..live import LivePlot
 from ..plotting.what_ifs import sensitivity_bars
@@ -137,7 +137,7 @@ class WhatIfView(PlotView):
         finally:
             self._showing = False
 
-    @param.depends(*(f"state.{n}" for n in BAND_INPUTS), "fit.fit_result", *(f"state.{n}" for n in FIT_DATA),
+    @param.depends(*(f"state.{n}" for n in BAND_INPUTS), *FIT_DEPENDS,
                    "state.freq_min", "state.freq_max", watch=True)
     def _on_band(self):
         self.changed()  # the band status (and the bars) refresh while the tab is shown
