@@ -38,9 +38,10 @@ def parse_tolerances(text: str) -> dict[str, float]:
 
 
 class ToleranceBands(param.Parameterized):
-    """The tolerance bands' inputs and their message. A session's state (:class:`app.state.
-    ExplorerState`) is one; its ``fit_result`` (the last fit, or None) may give the material's
-    spread instead of its tolerances."""
+    """The tolerance bands' inputs. A session's state (:class:`app.state.ExplorerState`) is one;
+    the bands (or why there are none) are computed from their values by the pure functions
+    below: :func:`band_tolerances`, :func:`banded`. Nothing here is written while bands are
+    computed."""
 
     tolerance_text = param.String(default="", doc="The tolerances in ± % as a link writes them (TOLERANCE_KEYS): "
                                   "mu:10,L:1 is µ ±10 % and L ±1 %.")
@@ -53,7 +54,6 @@ class ToleranceBands(param.Parameterized):
     band_from_fit = param.Boolean(default=False, label="Material from the fit's covariance",
                                   doc="Draw the five material parameters from the last fit's standard errors and "
                                   "correlation (instead of their tolerances).")
-    band_message = param.String(default="", doc="Why no band is drawn, if one was asked for.")
 
     @property
     def tolerance_pct(self) -> dict[str, float]:
@@ -65,47 +65,72 @@ class ToleranceBands(param.Parameterized):
     def tolerance_pct(self, values: dict[str, float]):
         self.tolerance_text = ",".join(f"{TOLERANCE_KEYS[n]}:{v:g}" for n, v in values.items() if v)
 
-    def tolerances(self) -> Tolerances | None:
-        """The tolerances the bands are drawn with (:class:`core.whatif.tolerance.Tolerances`), None
-        when bands are off or nothing varies. Raises ToleranceError with the reason."""
-        if not self.band_on:
-            return None
-        material = set(MATERIAL) if self.band_from_fit else set()
-        relative = {n: v / 100.0 for n, v in self.tolerance_pct.items() if v and n not in material}
+    def band_inputs(self) -> dict:
+        """The band inputs' values, by the names of :func:`band_tolerances`' arguments."""
+        return {name: getattr(self, name) for name in BAND_INPUTS}
+
+
+# the band inputs (parameters of ToleranceBands); a band also depends on the fit (fit_result of
+# app.fit_state.FitState) whose covariance it may use
+BAND_INPUTS = tuple(n for n in ToleranceBands.param if n != "name")
+
+
+def band_tolerances(tolerance_text: str, band_on: bool, band_distribution: str, band_samples: int,
+                    band_seed: int, band_from_fit: bool, fit_result=None) -> Tolerances | str | None:
+    """The tolerances the bands are drawn with (:class:`core.whatif.tolerance.Tolerances`), from
+    the band inputs' values (:class:`ToleranceBands`) and the last fit (a
+    :class:`core.identify.fit.FitResult` or None, for ``band_from_fit``); None when the bands are
+    off; else the reason why there is no band (a str). Pure."""
+    if not band_on:
+        return None
+    try:
+        material = set(MATERIAL) if band_from_fit else set()
+        relative = {n: v / 100.0 for n, v in parse_tolerances(tolerance_text).items() if v and n not in material}
         covariance = None
-        if self.band_from_fit:
-            if self.fit_result is None:
-                raise ToleranceError("no fit yet: fit measured data first (Measured data and fit), or use tolerances")
-            covariance = FitCovariance.of(self.fit_result)
-        tol = Tolerances(relative, distribution=self.band_distribution, samples=self.band_samples, seed=self.band_seed,
+        if band_from_fit:
+            if fit_result is None:
+                return "no fit yet: fit measured data first (Measured data and fit), or use tolerances"
+            covariance = FitCovariance.of(fit_result)
+        tol = Tolerances(relative, distribution=band_distribution, samples=band_samples, seed=band_seed,
                          covariance=covariance)
-        if not tol.varied:
-            raise ToleranceError("every tolerance is 0: give one (± %) to see a band")
-        return tol
-
-    def checked_tolerances(self) -> Tolerances | None:
-        """:meth:`tolerances`, or None with the reason in :attr:`band_message` (a band computed
-        with them may still say why it cannot be: :meth:`banded`)."""
-        try:
-            tol = self.tolerances()
-        except ToleranceError as exc:
-            self.band_message = str(exc)
-            return None
-        self.band_message = ""
-        return tol
-
-    def banded(self, compute):
-        """``compute(tolerances)`` with the tolerances of the bands, or None when there are none
-        or a sample cannot be computed (the reason in :attr:`band_message`)."""
-        tolerances = self.checked_tolerances()
-        if tolerances is None:
-            return None
-        try:
-            return compute(tolerances)
-        except ToleranceError as exc:  # e.g. a sample outside the finite-length table
-            self.band_message = str(exc)
-            return None
+    except ToleranceError as exc:
+        return str(exc)
+    if not tol.varied:
+        return "every tolerance is 0: give one (± %) to see a band"
+    return tol
 
 
-# what a band depends on: the inputs above, and the fit whose covariance it may use
-BAND_PARAMETERS = (*(n for n in ToleranceBands.param if n not in ("name", "band_message")), "fit_result")
+def banded(tolerances: Tolerances | str | None, compute) -> tuple[object | None, str]:
+    """``(compute(tolerances), "")`` for :func:`band_tolerances`' outcome; ``(None, "")`` when the
+    bands are off; ``(None, reason)`` when there are no tolerances or a band with them cannot be
+    computed (``compute`` raised ToleranceError: e.g. a sample outside the finite-length
+    table). Pure as ``compute`` is."""
+    if tolerances is None:
+        return None, ""
+    if isinstance(tolerances, str):
+        return None, tolerances
+    try:
+        return compute(tolerances), ""
+    except ToleranceError as exc:
+        return None, str(exc)
+
+
+def tolerance_key(tolerances: Tolerances) -> tuple:
+    """A hashable form of ``tolerances`` (a cache's key), equal for equal tolerances given in the
+    same order (the order of a fit's parameters sets the order of their draws):
+    :func:`tolerances_of` gives them back."""
+    t = tolerances
+    covariance = None if t.covariance is None else (
+        tuple(t.covariance.standard_errors.items()),
+        tuple((a, tuple(row.items())) for a, row in t.covariance.correlation.items()))
+    return (tuple(t.relative.items()), tuple(t.absolute.items()), t.distribution, t.samples, t.seed,
+            tuple(t.percentiles), covariance)
+
+
+def tolerances_of(key: tuple) -> Tolerances:
+    """The tolerances of a :func:`tolerance_key`."""
+    relative, absolute, distribution, samples, seed, percentiles, covariance = key
+    if covariance is not None:
+        errors, correlation = covariance
+        covariance = FitCovariance(dict(errors), {a: dict(row) for a, row in correlation})
+    return Tolerances(dict(relative), dict(absolute), distribution, samples, seed, percentiles, covariance)

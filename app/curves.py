@@ -7,6 +7,7 @@ asking twice for the same curve costs a look-up.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -27,9 +28,10 @@ from core.loops import loop
 from core.material import ConvergenceError
 from core.residuals import gap
 from core.response import loss_factor, magnitude_residual_pct
-from core.whatif.tolerance import band
+from core.whatif.tolerance import ToleranceError, band
 
 from . import units
+from .bands import tolerance_key, tolerances_of
 
 SLICES = (1, 2, 3, "continuum")
 # the frequency sweeps are drawn at these equivalent strains, as multiples of ε½
@@ -264,35 +266,44 @@ class ExplorerData:
     bands: dict | None = None  # operating_bands, when tolerances are set
 
 
-def operating_bands(design: Design, frequency_hz: float, amplitude: float, f, x, tolerances,
-                    cache: dict | None = None) -> dict:
-    """Tolerance bands (:mod:`core.whatif.tolerance`) of the operating curves: against frequency ``f``
-    at the operating ``amplitude`` and against amplitude ``x`` (display units) at the operating
-    frequency. For each of ``"frequency"`` and ``"amplitude"``, (low, high) of ``magnitude``
-    (display unit) and ``loss_factor`` at the tolerances' first and last percentiles; ``"point"``
-    the operating point's band, spreads and first-order spreads.
+def operating_bands(design: Design, frequency_hz: float, amplitude: float, freq_range, tolerances,
+                    n_freq: int = 120, n_amp: int = 120) -> dict:
+    """Tolerance bands (:mod:`core.whatif.tolerance`) of the operating curves: against frequency
+    (``n_freq`` points over ``freq_range``, Hz) at the operating ``amplitude`` (display units) and
+    against amplitude (:func:`amplitude_grid` of ``n_amp`` points) at the operating frequency. For
+    each of ``"frequency"`` and ``"amplitude"``, (low, high) of ``magnitude`` (display unit) and
+    ``loss_factor`` at the tolerances' first and last percentiles; ``"point"`` the operating
+    point's band, spreads and first-order spreads. Raises ToleranceError with the reason there
+    is no band.
 
     Three Monte Carlos with the same draws (the seed): each curve's (a frequency sweep at one
     strain computes the friction branch once, an amplitude sweep the fractional branch once) and
-    the point's. ``cache`` (a dict the caller keeps) holds the last few: moving the operating
-    amplitude recomputes the frequency curve's band and the point's, not the amplitude curve's."""
+    the point's. Cached (``functools.lru_cache`` on the values, the tolerances by
+    :func:`app.bands.tolerance_key`), the bands and the reasons alike, and each of the three
+    bands too: moving the operating amplitude recomputes the frequency curve's band and the
+    point's, not the amplitude curve's. The result is shared: read it, do not change it."""
+    outcome = _operating_bands(design, float(frequency_hz), float(amplitude),
+                               (float(freq_range[0]), float(freq_range[1])), int(n_freq), int(n_amp),
+                               tolerance_key(tolerances))
+    if isinstance(outcome, str):
+        raise ToleranceError(outcome)
+    return outcome
+
+
+@functools.lru_cache(maxsize=8)
+def _operating_bands(design: Design, frequency_hz: float, amplitude: float, freq_range: tuple[float, float],
+                     n_freq: int, n_amp: int, tolerances: tuple) -> dict | str:
+    """:func:`operating_bands`, or the reason there is none (a str)."""
     mode = design.mode
-    a_si, x_si = float(units.to_si_amplitude(amplitude, mode)), units.to_si_amplitude(x, mode)
-    f = np.asarray(f, dtype=float)
-
-    def cached(*points):
-        key = (design, repr(tolerances), *(np.asarray(p, dtype=float).tobytes() for p in points))
-        if cache is not None and key in cache:
-            return cache[key]
-        result = band(design, *points, tolerances)
-        if cache is not None:
-            while len(cache) >= 6:
-                cache.pop(next(iter(cache)))
-            cache[key] = result
-        return result
-
-    swept = {"frequency": cached(f, a_si), "amplitude": cached(frequency_hz, x_si)}
-    point = cached(frequency_hz, a_si)
+    a_si = float(units.to_si_amplitude(amplitude, mode))
+    f = tuple(float(v) for v in np.linspace(*freq_range, n_freq))
+    x_si = tuple(float(v) for v in units.to_si_amplitude(amplitude_grid(design, n_amp), mode))
+    try:
+        swept = {"frequency": _band(design, f, (a_si,), tolerances),
+                 "amplitude": _band(design, (frequency_hz,), x_si, tolerances)}
+        point = _band(design, frequency_hz, a_si, tolerances)
+    except ToleranceError as exc:
+        return str(exc)
     low, high = min(point.percentiles), max(point.percentiles)
     out = {against: {"magnitude": tuple(units.display_stiffness(b.magnitude[q], mode) for q in (low, high)),
                      "loss_factor": tuple(b.loss_factor[q] for q in (low, high))}
@@ -306,6 +317,14 @@ def operating_bands(design: Design, frequency_hz: float, amplitude: float, f, x,
                     "std_loss_factor": float(point.std_loss_factor),
                     "first_order_loss_factor": float(point.first_order_loss_factor)}
     return out
+
+
+@functools.lru_cache(maxsize=6)
+def _band(design: Design, frequency_hz, amplitude, tolerances: tuple):
+    """The core's band over the points (a float or a tuple of them each, Hz and SI drive) under
+    the tolerances of a :func:`app.bands.tolerance_key`."""
+    return band(design, np.asarray(frequency_hz, dtype=float), np.asarray(amplitude, dtype=float),
+                tolerances_of(tolerances))
 
 
 def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq_range=(1.0, 100.0),
@@ -404,14 +423,39 @@ def card_sweeps(design: Design, frequency_hz: float, strains=None) -> dict:
 
 def card_bands(design: Design, frequency_hz: float, tolerances, strains=None) -> dict:
     """Each direction's tolerance band along :func:`card_sweeps`' curves: ``magnitude_band`` and
-    ``loss_factor_band``, (low, high) at the first and last percentiles (display units)."""
-    out = {}
-    for mode, d, drive in _card_directions(design, _card_strains(strains)):
-        b = band(d, frequency_hz, drive, tolerances)
-        low, high = min(b.percentiles), max(b.percentiles)
-        out[mode] = {"magnitude_band": tuple(units.display_stiffness(b.magnitude[q], mode) for q in (low, high)),
-                     "loss_factor_band": (b.loss_factor[low], b.loss_factor[high])}
+    ``loss_factor_band``, (low, high) at the first and last percentiles (display units). Raises
+    ToleranceError with the reason there is no band. Cached like :func:`operating_bands` (the
+    result is shared: read it, do not change it)."""
+    key = None if strains is None else tuple(float(v) for v in np.ravel(strains))
+    outcome = _card_bands(design, float(frequency_hz), tolerance_key(tolerances), key)
+    if isinstance(outcome, str):
+        raise ToleranceError(outcome)
+    return outcome
+
+
+@functools.lru_cache(maxsize=4)
+def _card_bands(design: Design, frequency_hz: float, tolerances: tuple, strains: tuple | None) -> dict | str:
+    """:func:`card_bands`, or the reason there is none (a str)."""
+    tol, out = tolerances_of(tolerances), {}
+    try:
+        for mode, d, drive in _card_directions(design, _card_strains(strains)):
+            b = band(d, frequency_hz, drive, tol)
+            low, high = min(b.percentiles), max(b.percentiles)
+            out[mode] = {"magnitude_band": tuple(units.display_stiffness(b.magnitude[q], mode) for q in (low, high)),
+                         "loss_factor_band": (b.loss_factor[low], b.loss_factor[high])}
+    except ToleranceError as exc:
+        return str(exc)
     return out
+
+
+def _clear_operating_bands():
+    _operating_bands.cache_clear()
+    _band.cache_clear()
+
+
+# the caches' hits and misses (functools.lru_cache's cache_info), and their clearing
+operating_bands.cache_info, operating_bands.cache_clear = _operating_bands.cache_info, _clear_operating_bands
+card_bands.cache_info, card_bands.cache_clear = _card_bands.cache_info, _card_bands.cache_clear
 
 
 def _card_strains(strains) -> np.ndarray:

@@ -14,7 +14,9 @@ from core.io.export import export
 from core.io.table import csv_text
 from core.whatif.tolerance import band, band_columns
 
+from .bands import band_tolerances, banded
 from .curves import amplitude_grid, fletcher_gent_amplitudes
+from .fit_state import FitState
 from .state import ExplorerState
 from .units import to_si_amplitude
 
@@ -30,9 +32,9 @@ TOOL_FORMATS = {
 class ExportView(pn.viewable.Viewer):
     """Download the design file and the stiffness table; PNGs from each plot's toolbar."""
 
-    def __init__(self, state: ExplorerState, **params):
+    def __init__(self, state: ExplorerState, fit: FitState, **params):
         super().__init__(**params)
-        self.state = state
+        self.state, self.fit = state, fit
         self.design_file = pn.widgets.FileDownload(
             callback=self._design_json, filename="bushing-design.json", label="Design file (JSON)",
             color="default", sizing_mode="stretch_width",
@@ -65,7 +67,8 @@ class ExportView(pn.viewable.Viewer):
         s = self.state
         f, x = np.linspace(*s.freq_range, n_freq), to_si_amplitude(amplitude_grid(s.design, n_amp), s.design.mode)
         table = stiffness(s.design, f, x).table()
-        columns = s.banded(lambda tol: band_columns(band(s.design, f[None, :], np.asarray(x)[:, None], tol)))
+        tolerances = band_tolerances(**s.band_inputs(), fit_result=self.fit.fit_result)
+        columns, _reason = banded(tolerances, lambda tol: band_columns(band(s.design, f[None, :], np.asarray(x)[:, None], tol)))
         return {**table, **(columns or {})}
 
     def tool_text(self, label: str) -> str:

@@ -11,6 +11,7 @@ import panel as pn
 from . import patches
 from .diagnosis_state import DiagnosisState
 from .export import ExportView
+from .fit_state import FitState
 from .inputs import DesignInputs, status_banner
 from .link import URL_DELAY_MS, UrlLink
 from .state import ExplorerState
@@ -55,19 +56,20 @@ class App(pn.viewable.Viewer):
     LAZY_TABS = (
         ("Slices", "slices", lambda app: SlicesView(app.state)),
         ("Fletcher–Gent, branch by branch", "teaching", lambda app: TeachingView(app.state)),
-        ("Measured data and fit", "measured", lambda app: MeasuredView(app.state)),
+        ("Measured data and fit", "measured", lambda app: MeasuredView(app.state, app.fit)),
         ("Find the missing effect", "diagnosis", lambda app: DiagnosisView(DiagnosisState(app.state))),
-        ("Every direction", "card", lambda app: CardView(app.state)),
-        ("What-ifs", "whatif", lambda app: WhatIfView(app.state)),
+        ("Every direction", "card", lambda app: CardView(app.state, app.fit)),
+        ("What-ifs", "whatif", lambda app: WhatIfView(app.state, app.fit)),
     )
 
     def __init__(self, state: ExplorerState | None = None, **params):
         super().__init__(**params)
         self.state = state or ExplorerState()
+        self.fit = FitState(self.state)  # the fit of the session's measured data
         self.inputs = DesignInputs(self.state)
-        self.plots = ExplorerPlots(self.state)
+        self.plots = ExplorerPlots(self.state, self.fit)
         self.compare = CompareView(self.state)
-        self.export = ExportView(self.state)
+        self.export = ExportView(self.state, self.fit)
         self._built: dict[str, pn.viewable.Viewer] = {}
         self._holders = {name: pn.Column(sizing_mode="stretch_width") for _title, name, _build in self.LAZY_TABS}
         self.tabs = pn.Tabs(

@@ -8,7 +8,6 @@ draw from the data methods below, which ask the (cached) core; nothing here draw
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
@@ -16,12 +15,11 @@ import param
 
 from core import PAPER_B, TABLE_1, Design
 from core.data import DataError, MeasuredLoop, MeasuredStiffness
-from core.identify.fit import FitResult, fit_global, fit_two_step, predicted, selection
 from core.io.measured import combined, parse_loop, parse_stiffness
 from core.parameters import MODE_TABLE, MODES
 
 from . import curves, units
-from .bands import BAND_PARAMETERS, ToleranceBands
+from .bands import BAND_INPUTS, ToleranceBands
 from .fields import DESIGN_FIELDS, DesignFields, design_from_fields, display_values
 from .units import FREQUENCY_BOUNDS
 
@@ -61,8 +59,9 @@ def _amplitude_doc() -> str:
 
 class ExplorerState(DesignFields, ToleranceBands):
     """One user's design session: inputs (the design's fields, :class:`app.fields.DesignFields`),
-    the operating point, the pinned reference, measured data and the fit, the tolerance bands
-    (:class:`app.bands.ToleranceBands`)."""
+    the operating point, the pinned reference, measured data, the tolerance bands' inputs
+    (:class:`app.bands.ToleranceBands`). The fit of the measured data is the session's
+    :class:`app.fit_state.FitState`."""
 
     preset = param.Selector(
         objects=list(PRESETS), default=None, allow_None=True, label="Preset",
@@ -97,18 +96,6 @@ class ExplorerState(DesignFields, ToleranceBands):
     measured_loop = param.ClassSelector(class_=MeasuredLoop, default=None, allow_None=True,
                                         doc="A measured steady loop (SI).")
     data_message = param.String(default="", doc="What was wrong with the last file, if anything.")
-    fit_result = param.ClassSelector(class_=FitResult, default=None, allow_None=True)
-    fit_method = param.Selector(
-        objects=["global", "two-step"], default="global", label="Method",
-        doc="Global: all five parameters to all data at once. Two-step (the thesis'): the loop "
-        "gives µ, σ_fmax and ε½, the frequency sweep at one amplitude gives m and α.",
-    )
-    sweep_amplitude = param.Number(default=None, allow_None=True, label="Sweep amplitude",
-                                   doc="The amplitude (SI) whose frequency sweep the two-step fit uses.")
-    fit_on = param.String(default="", label="Fit on (the rest is predicted)",
-                          doc="Empty: fit every row. Else mode=NAME[+NAME…] and/or amplitude=VALUE[+VALUE…] "
-                          "(SI), comma-separated, e.g. mode=axial,amplitude=1e-4: the fit uses those rows and "
-                          "predicts the others, with the gap of each mode and amplitude.")
 
     def __init__(self, **params):
         self._loaded = []  # the last design loaded (a file, a fit): kept while the inputs show it
@@ -161,7 +148,7 @@ class ExplorerState(DesignFields, ToleranceBands):
             amplitude=float(f"{x_mid:.3g}"),
         )
 
-    # ---- measured data and fitting -----------------------------------------------------------
+    # ---- measured data (their fit: app.fit_state.FitState) ------------------------------------
 
     def load_measured(self, content: bytes | str, filename: str = "stiffness file") -> bool:
         """Read a measured-stiffness CSV (docs/files.md); on a bad file say why and keep the last."""
@@ -190,33 +177,12 @@ class ExplorerState(DesignFields, ToleranceBands):
         if problem:
             self.data_message = f"{filename}: {problem}; not loaded"
             return False
-        self.param.update(measured_loop=data, fit_result=None,
+        self.param.update(measured_loop=data,
                           frequency_hz=float(np.clip(f, *FREQUENCY_BOUNDS)), amplitude=float(f"{x:.4g}"))
         return True
 
     def clear_measured(self):
-        self.param.update(measured=None, measured_loop=None, data_message="", fit_result=None)
-
-    def compute_fit(self) -> FitResult:
-        """Fit the five material parameters to the measured data (the current design is the
-        first start). Pure: safe to run in a worker thread; :meth:`store_fit` stores it."""
-        if self.measured is None and self.measured_loop is None:
-            raise ValueError("load measured stiffness (and optionally a loop) first")
-        if self.fit_method == "two-step":
-            if self.measured is None or self.measured_loop is None:
-                raise ValueError("the two-step fit needs a loop and a frequency sweep: load both")
-            amps = measured_amplitudes(self.measured)
-            amp = self.sweep_amplitude if self.sweep_amplitude in amps else amps[0]
-            sweep = self.measured.select(self.measured.amplitude == amp)
-            if len(sweep) < 3:
-                raise ValueError("the sweep at that amplitude has fewer than 3 points")
-            return fit_two_step(self.design, self.measured_loop, sweep)
-        if not self.fit_on.strip() or self.measured is None:
-            return fit_global(self.design, self.measured, self.measured_loop)
-        spec = self.fit_on.strip()[:500]
-        chosen = selection(self.measured, self.design.mode, spec)
-        result = fit_global(self.design, self.measured.select(chosen), self.measured_loop)
-        return dataclasses.replace(result, prediction=predicted(result, self.measured, chosen, spec))
+        self.param.update(measured=None, measured_loop=None, data_message="")
 
     def load_measured_files(self, files: dict) -> bool:
         """Several measured-stiffness files (name → content) as one table: a file without a mode
@@ -233,30 +199,8 @@ class ExplorerState(DesignFields, ToleranceBands):
         if not parts:
             self.data_message = note
             return False
-        self.param.update(measured=combined(parts, self.design.mode), fit_result=None, data_message=note)
+        self.param.update(measured=combined(parts, self.design.mode), data_message=note)
         return not refused
-
-    def try_fit(self) -> FitResult | str:
-        """:meth:`compute_fit`, or why it cannot run (pure: safe in a worker thread)."""
-        try:
-            return self.compute_fit()
-        except ValueError as exc:
-            return str(exc)
-
-    def store_fit(self, outcome: FitResult | str):
-        """Keep a fit (and forget an earlier message), or say why there is none."""
-        if isinstance(outcome, FitResult):
-            self.param.update(fit_result=outcome, data_message="")
-        else:
-            self.data_message = outcome
-
-    def run_fit(self):
-        self.store_fit(self.try_fit())
-
-    def use_fit(self):
-        """Take the fitted design into the explorer, keeping the operating point."""
-        if self.fit_result is not None:
-            self.adopt(self.fit_result.design)
 
     def adopt(self, design: Design):
         """Show ``design`` (a fit, a diagnosis) at the operating point the user had."""
@@ -316,8 +260,9 @@ def measured_amplitudes(measured: MeasuredStiffness | None) -> list[float]:
     return [] if measured is None else [float(v) for v in measured.amplitudes()]
 
 
-# what the views draw, by what it is: the state's parameters of each (a view names the ones it
-# shows, app.views.PlotView.shows; it is told of a change of any of their parameters)
+# what the views draw, by what it is: the state's parameters of each, and those of the session's
+# fit (app.fit_state.FitState) as "fit.NAME" (a view names the ones it shows, app.views.PlotView.shows;
+# it is told of a change of any of their parameters)
 SHOWN = {
     "design": ("design",),  # the last valid design (SI)
     "frequency": ("frequency_hz",),  # the operating point's frequency
@@ -325,9 +270,8 @@ SHOWN = {
     "sweep range": ("freq_range",),
     "reference": ("reference",),
     "measured": ("measured", "measured_loop"),
-    "bands": BAND_PARAMETERS,
-    "data message": ("data_message",),
-    "fit": ("fit_result", "fit_method"),
+    "bands": (*BAND_INPUTS, "fit.fit_result"),  # the band inputs, and the fit whose covariance they may use
+    "fit": ("fit.fit_result", "fit.fit_method"),
 }
 
 

@@ -42,18 +42,30 @@ class PlotView(pn.viewable.Viewer):
         self._drawn: tuple | None = None  # the values drawn last
         self.dims: dict = {}
         super().__init__(state=state, **params)
-        state.param.watch(self._on_change, list(self.watched()))
-        if self.own:
-            self.param.watch(self._on_change, list(self.own))
+        for owner, names in self._sources().items():
+            owner.param.watch(self._on_change, list(names))
 
     @classmethod
     def watched(cls) -> tuple[str, ...]:
-        """The state's parameters the view draws from (:data:`app.state.SHOWN`)."""
-        return tuple(name for key in cls.shows for name in SHOWN[key])
+        """The parameters the view draws from: the state's (:data:`app.state.SHOWN`; the fit's as
+        ``fit.NAME``) and its own (:attr:`own`, as ``self.NAME``)."""
+        return (*(name for key in cls.shows for name in SHOWN[key]), *(f"self.{n}" for n in cls.own))
+
+    def _owner(self, name: str):
+        """The object holding a parameter of :meth:`watched`, and the parameter's own name."""
+        owner, _, own = name.rpartition(".")
+        return {"": self.state, "self": self}.get(owner) or getattr(self, owner), own
+
+    def _sources(self) -> dict:
+        out: dict = {}
+        for name in self.watched():
+            owner, own = self._owner(name)
+            out.setdefault(owner, []).append(own)
+        return out
 
     def values(self) -> tuple:
         """The values the view draws from, now."""
-        return (*(getattr(self.state, n) for n in self.watched()), *(getattr(self, n) for n in self.own))
+        return tuple(getattr(*self._owner(name)) for name in self.watched())
 
     def _on_change(self, *_events):
         self.changed()

@@ -99,12 +99,12 @@ def test_fit_in_the_app_and_take_it_into_the_explorer(app):
     app.state.load_measured_loop(loop_bytes)
     app.state.param.update(shear_modulus_mpa=1.5, friction_strain_half=2e-3)
     app.tabs.active = 3
-    app.state.run_fit()
-    r = app.state.fit_result
+    app.fit.run_fit()
+    r = app.fit.fit_result
     assert r.gap < 0.01 and not app.measured.use.disabled
     assert "Correlation" in app.measured.results.object
     f_op, x_op = app.state.frequency_hz, app.state.amplitude
-    app.state.use_fit()
+    app.fit.use_fit()
     assert app.state.design.material.shear_modulus == pytest.approx(r.design.material.shear_modulus, rel=1e-9)
     assert (app.state.frequency_hz, app.state.amplitude) == (f_op, x_op)
     assert curves.measured_residuals(app.state.design, app.state.measured)["gap"] == pytest.approx(r.gap, rel=1e-6)
@@ -118,8 +118,8 @@ def test_a_fit_the_data_cannot_determine_says_so_in_the_app(app):
     sweep = (Path(__file__).resolve().parent.parent / "examples" / "paper_b_sweep_0.1mm.csv").read_bytes()
     assert app.state.load_measured(sweep, "paper_b_sweep_0.1mm.csv")
     app.tabs.active = 3
-    app.state.run_fit()
-    r = app.state.fit_result
+    app.fit.run_fit()
+    r = app.fit.fit_result
     assert "shear_modulus" in r.undetermined
     text = app.measured.results.object
     row = next(line for line in text.splitlines() if line.startswith("| µ"))
@@ -128,23 +128,51 @@ def test_a_fit_the_data_cannot_determine_says_so_in_the_app(app):
 
 
 def test_fit_without_data_says_so(app):
-    app.state.run_fit()
-    assert "load measured" in app.state.data_message and app.state.fit_result is None
+    app.fit.run_fit()
+    assert "load measured" in app.state.data_message and app.fit.fit_result is None
 
 
 def test_the_thesis_two_step_fit_in_the_app(app):
     stiff, loop_bytes = example_files()
     app.state.load_measured(stiff)
-    app.state.fit_method = "two-step"
-    app.state.run_fit()
+    app.fit.fit_method = "two-step"
+    app.fit.run_fit()
     assert "loop" in app.state.data_message  # needs both
     app.state.load_measured_loop(loop_bytes)
     app.tabs.active = 3
     assert len(app.measured.sweep.options) == 5 and app.measured.sweep.visible
     app.measured.sweep.value = 1e-4
-    app.state.run_fit()
-    r = app.state.fit_result
+    app.fit.run_fit()
+    r = app.fit.fit_result
     assert r.method == "two-step" and r.points == 30  # the 0.1 mm sweep
     assert app.state.data_message == ""  # the earlier refusal is no longer shown
     assert r.design.material.shear_modulus == pytest.approx(2.42e6, rel=0.03)
     assert "two-step" in app.measured.results.object
+
+
+def test_new_data_forgets_the_fit_and_each_view_refreshes_once(app):
+    """A fit belongs to its data: loading new data (or clearing it) forgets it, and each view
+    that shows the fit (the tab's table, a band from the fit's covariance) refreshes once, with
+    the new data and no fit."""
+    stiff, loop_bytes = example_files()
+    app.state.load_measured(stiff)
+    app.state.load_measured_loop(loop_bytes)
+    app.state.param.update(band_on=True, band_from_fit=True, band_samples=50)
+    app.tabs.active = 3
+    app.fit.run_fit()
+    assert app.fit.fit_result is not None and "Fitted" in app.measured.results.object
+    views = {3: app.measured, 0: app.plots, [t for t, *_ in App.LAZY_TABS].index("Every direction") + 1: app.card,
+             [t for t, *_ in App.LAZY_TABS].index("What-ifs") + 1: app.whatif}
+    for view in views.values():
+        view.calls, draw = [], view._update
+        view._update = lambda view=view, draw=draw: view.calls.append((view.state.measured, app.fit.fit_result)) or draw()
+    for load, fit_was_there in ((lambda: app.state.load_measured(stiff), True), (app.state.clear_measured, False)):
+        load()
+        for tab, view in views.items():  # each drawn once, when its tab is shown, with the new data and no fit
+            app.tabs.active = tab
+            # the card and the what-ifs draw no data: after a clear (the fit already gone), nothing new
+            drawn = fit_was_there or view in (app.measured, app.plots)
+            assert view.calls == [(app.state.measured, None)] * drawn, type(view).__name__
+            view.calls.clear()
+    app.measured.refresh()
+    assert app.measured.use.disabled and app.measured.results.object == ""

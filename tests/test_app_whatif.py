@@ -15,6 +15,8 @@ from core.synthetic import synthetic_stiffness
 from core.whatif.sensitivity import elasticities
 from core.whatif.tolerance import Tolerances, band
 
+WHAT_IFS = [t for t, *_ in App.LAZY_TABS].index("What-ifs") + 1  # the What-ifs tab's index
+
 
 @pytest.fixture
 def app():
@@ -59,22 +61,25 @@ def test_tolerances_that_cannot_be_used_say_why_and_keep_the_plots(app):
     v.tolerance_inputs["outer_radius"].value = 50  # b − 50 % < a
     app.state.band_on = True
     app.tabs.active = 0
-    assert "no rubber" in app.state.band_message and "No tolerance band" in app.plots.summary.object
-    assert "No band" in v.band_status.object
+    assert "No tolerance band" in app.plots.summary.object and "no rubber" in app.plots.summary.object
     assert all(e.label != "5–95 % band" for e in app.plots.frame(("magnitude", "frequency")))
+    app.tabs.active = WHAT_IFS
+    assert "No band" in v.band_status.object and "no rubber" in v.band_status.object
     v.tolerance_inputs["outer_radius"].value = 0
     app.state.band_from_fit = True  # no fit yet
-    assert "no fit yet" in app.state.band_message.lower()
+    assert "no fit yet" in v.band_status.object.lower()
+    app.tabs.active = 0
+    assert "no fit yet" in app.plots.summary.object.lower()
 
 
 def test_a_fits_covariance_makes_the_band(app):
     data = synthetic_stiffness(PAPER_B, np.linspace(5, 155, 20), [1e-5, 1e-4, 3.5e-4], noise=0.005, seed=1)
     app.state.measured = data
-    app.state.fit_result = fit = fit_global(PAPER_B, data, intervals=False)
+    app.fit.fit_result = fit = fit_global(PAPER_B, data, intervals=False)
     app.state.load_design(fit.design)
     app.state.param.update(band_on=True, band_from_fit=True, band_samples=100)
     app.tabs.active = 0
-    assert app.state.band_message == ""
+    assert "Tolerance band" in app.plots.summary.object and "No tolerance band" not in app.plots.summary.object
     f, low, high = area(app.plots.frame(("magnitude", "frequency")), "5–95 % band")
     k = np.abs(stiffness_points(app.state.design, f, app.state.amplitude * 1e-3)) / 1e6
     assert np.all(low < k) and np.all(k < high) and np.all((high - low) / k < 0.05)
@@ -136,7 +141,7 @@ def test_tolerances_travel_in_a_link(app):
     app.tabs.active = 0
     assert "Tolerance band" in app.plots.summary.object
     app.state.tolerance_text = "mu:lots"  # a hand-edited link: said, and no band
-    assert "key:percent pairs" in app.state.band_message and "No tolerance band" in app.plots.summary.object
+    assert "key:percent pairs" in app.plots.summary.object and "No tolerance band" in app.plots.summary.object
 
 
 def test_a_band_that_leaves_the_table_keeps_the_card_and_says_why(app):
@@ -146,8 +151,10 @@ def test_a_band_that_leaves_the_table_keeps_the_card_and_says_why(app):
     app.state.band_on = True
     app.tabs.active = [t for t, *_ in App.LAZY_TABS].index("Every direction") + 1
     assert "At 10 Hz" in app.card.table.object and "not available" not in app.card.table.object
-    assert "finite-length shape factors cover" in app.state.band_message
     assert all("band" not in (e.label or "") for e in app.card.frame("translation"))
+    app.tabs.active = WHAT_IFS
+    assert "No band" in app.whatif.band_status.object
+    assert "finite-length shape factors cover" in app.whatif.band_status.object
 
 
 def test_no_number_field_of_any_tab_waits_before_it_sends_its_value(app):
@@ -203,3 +210,42 @@ def test_the_targets_form_is_its_own_state_and_its_file_says_every_field_in_si(a
     assert len(problem_from_dict(json.loads(text)).targets) == 3  # the command line's reader takes it
     with pytest.raises(ValueError):
         v.form.target_tolerance_pct = 60.0  # the field's bounds, as the tab's input had them
+
+
+def test_computing_the_bands_writes_nothing_to_the_state(app):
+    """A band that cannot be (b −50 % is below a) is computed by each tab shown after the change:
+    the reason is in the explorer's summary and the What-ifs status, and no parameter of the
+    session's state or fit changes while the tabs draw."""
+    v = app.whatif
+    app.tabs.active = len(App.LAZY_TABS) + 1  # About: no tab plots
+    app.state.tolerance_pct = {"outer_radius": 50.0}
+    app.state.band_on = True
+    events = []
+    for obj in (app.state, app.fit):
+        obj.param.watch(events.append, [n for n in obj.param if n != "name"])
+    app.tabs.active = 0
+    assert "No tolerance band" in app.plots.summary.object and "no rubber" in app.plots.summary.object
+    app.tabs.active = WHAT_IFS
+    assert "No band" in v.band_status.object and "no rubber" in v.band_status.object
+    app.tabs.active = [t for t, *_ in App.LAZY_TABS].index("Every direction") + 1
+    assert "magnitude_p5" not in app.export.stiffness_table(n_freq=5, n_amp=4)
+    assert [e.name for e in events] == []
+
+
+def test_the_explorers_bands_come_from_a_cache_of_values(app):
+    """Back at an operating point shown before, the explorer's bands are a hit of the
+    functools.lru_cache on the point's values (the tolerances by their hashable form): nothing
+    is computed again, the same band is shown."""
+    from app import curves
+
+    app.state.tolerance_pct = {"shear_modulus": 10.0}
+    app.state.param.update(band_on=True, band_samples=50)
+    app.tabs.active = 0
+    shown = app.plots.summary.object
+    app.state.amplitude = 0.2
+    assert app.plots.summary.object != shown
+    before = curves.operating_bands.cache_info()
+    app.state.amplitude = 0.1
+    after = curves.operating_bands.cache_info()
+    assert (after.hits, after.misses) == (before.hits + 1, before.misses)
+    assert app.plots.summary.object == shown

@@ -125,9 +125,10 @@ def test_the_explorer_reads_several_files_and_predicts_the_other_modes():
     assert len(s.measured) == 60 and sorted(set(s.measured.mode)) == ["axial", "radial"]
     assert len(curves.measured_points(s.measured, s.design.mode)["frequency_hz"]) == 30  # the explorer's mode (axial) is drawn
     assert "60 points in axial, radial (30 axial shown)" in app.measured.summary.object
-    s.param.update(fit_on="mode=axial", shear_modulus_mpa=1.5)
-    s.run_fit()
-    r = s.fit_result
+    s.shear_modulus_mpa = 1.5
+    app.fit.fit_on = "mode=axial"
+    app.fit.run_fit()
+    r = app.fit.fit_result
     assert r.prediction["points_fitted"] == 30 and r.prediction["gap_held_out"] < 3 * NOISE
     assert "**Fitted on mode=axial** (30 points)" in app.measured.results.object
     assert "| radial | " in app.measured.results.object and "predicted" in app.measured.results.object
@@ -138,8 +139,8 @@ def test_the_explorer_reads_several_files_and_predicts_the_other_modes():
     k = model_stiffness(r.design, read)
     np.testing.assert_allclose(np.sort(shown["radial, predicted"].dimension_values(1)),
                                np.sort(100 * (np.abs(k) / np.abs(read.stiffness) - 1)), rtol=1e-9)
-    s.fit_on = "mode=shear"
-    s.run_fit()
+    app.fit.fit_on = "mode=shear"
+    app.fit.run_fit()
     assert "chooses none" in s.data_message
 
 

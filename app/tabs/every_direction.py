@@ -12,7 +12,9 @@ from core.parameters import MODE, ROTATIONS, TRANSLATIONS
 from core.shape import long_shape_factor
 
 from .. import units
+from ..bands import band_tolerances, banded
 from ..curves import card_bands, card_sweeps, padded
+from ..fit_state import FitState
 from ..inputs import FloatInput
 from ..live import LivePlot
 from ..plotting.every_direction import card_dimensions, card_overlays
@@ -42,8 +44,10 @@ class CardView(PlotView):
                                    label=f"Displacement amplitude ({TRANSLATION.amplitude.display})")
     angle_rad = param.Number(0.01, bounds=(1e-7, 1.0), label=f"Angle amplitude ({ROTATION.amplitude.display})")
 
-    def __init__(self, state: ExplorerState, **params):
-        super().__init__(state, **params)
+    fit = param.ClassSelector(class_=FitState, doc="The session's fit (its covariance may make the bands).")
+
+    def __init__(self, state: ExplorerState, fit: FitState, **params):
+        super().__init__(state, fit=fit, **params)
         self.inputs = pn.Row(
             FloatInput.from_param(self.param.displacement_mm, start=1e-6, end=100.0, step=0.01),
             FloatInput.from_param(self.param.angle_rad, start=1e-7, end=1.0, step=0.001),
@@ -66,7 +70,8 @@ class CardView(PlotView):
         except ValueError as exc:  # outside the finite-length table, or an effect with no card
             self.table.object = f"_The card is not available for this design: {exc}_"
             return
-        for mode, b in (self.state.banded(lambda tol: card_bands(design, f, tol)) or {}).items():
+        tolerances = band_tolerances(**self.state.band_inputs(), fit_result=self.fit.fit_result)
+        for mode, b in (banded(tolerances, lambda tol: card_bands(design, f, tol))[0] or {}).items():
             data[mode].update(b)
         self.table.object = self.summary(design, f, rows)
         dims = ranged(self.dims, {axis: padded([data[m]["amplitude"] for m in modes], log=True)

@@ -5,10 +5,12 @@ pinned reference."""
 from __future__ import annotations
 
 import holoviews as hv
-import numpy as np
 import panel as pn
+import param
 
 from .. import curves, units
+from ..bands import band_tolerances, banded
+from ..fit_state import FitState
 from ..live import LivePlot
 from ..plotting.explorer import explorer_overlays
 from ..state import ExplorerState
@@ -24,13 +26,14 @@ class ExplorerPlots(PlotView):
 
     shows = ("design", "frequency", "amplitude", "sweep range", "reference", "measured", "bands")
 
-    def __init__(self, state: ExplorerState, **params):
-        super().__init__(state, **params)
+    fit = param.ClassSelector(class_=FitState, doc="The session's fit (its covariance may make the bands).")
+
+    def __init__(self, state: ExplorerState, fit: FitState, **params):
+        super().__init__(state, fit=fit, **params)
         self.summary = pn.pane.HTML("", sizing_mode="stretch_width", css_classes=["operating-point"],
                                     margin=(0, 10))
         self.loop: LivePlot | None = None
         self.grid: LivePlot | None = None
-        self._band_cache: dict = {}  # the last few tolerance bands (app.curves.operating_bands)
         self.draw()
 
     def frame(self, key) -> hv.Overlay:
@@ -40,8 +43,8 @@ class ExplorerPlots(PlotView):
     def _update(self):
         s = self.state
         design, f, x, freq_range = s.design, s.frequency_hz, s.amplitude, s.freq_range
-        bands = s.banded(lambda tol: curves.operating_bands(
-            design, f, x, np.linspace(*freq_range, 120), curves.amplitude_grid(design), tol, self._band_cache))
+        bands, reason = banded(band_tolerances(**s.band_inputs(), fit_result=self.fit.fit_result),
+                               lambda tol: curves.operating_bands(design, f, x, freq_range, tol))
         data = curves.explorer_data(design, f, x, freq_range=freq_range, reference=s.reference,
                                     measured=s.measured, measured_loop=s.measured_loop, bands=bands)
         overlays = explorer_overlays(data, self.dims_for(data.mode))
@@ -62,8 +65,8 @@ class ExplorerPlots(PlotView):
             f"<b>{point['magnitude']:.4g} {stiffness_unit}</b>, loss factor <b>{point['loss_factor']:.4f}</b></span>"
             + (f'<br><span class="band-summary">{band_words(data.bands["point"], stiffness_unit)}</span>'
                if data.bands else "")
-            + (f'<br><span class="band-message" style="color:#8a5300">No tolerance band: {s.band_message}</span>'
-               if s.band_message else "")
+            + (f'<br><span class="band-message" style="color:#8a5300">No tolerance band: {reason}</span>'
+               if reason else "")
         )
 
     def __panel__(self):

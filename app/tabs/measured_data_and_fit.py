@@ -1,5 +1,6 @@
 """The measured-data tab: load stiffness and loop files, see them over the model, fit the five
-material parameters, take the fitted design into the explorer. Thin: the state does the work."""
+material parameters, take the fitted design into the explorer. Thin: the state (the data) and the fit state
+(:mod:`app.fit_state`) do the work."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import logging
 
 import numpy as np
 import panel as pn
+import param
 
 from core import PAPER_B
 from core.parameters import BY_NAME, MATERIAL
@@ -16,6 +18,7 @@ from core.synthetic import paper_b_example
 
 from .. import curves, units
 from ..curves import padded
+from ..fit_state import FIT_DEPENDS, FitState
 from ..live import LivePlot
 from ..plotting.measured_data_and_fit import prediction_overlay, residual_overlays
 from ..plotting.style import ranged
@@ -34,10 +37,12 @@ FITTED = " and ".join([", ".join(BY_NAME[p].symbol for p in MATERIAL[:-1]), BY_N
 class MeasuredView(PlotView):
     """Upload, fit and residuals."""
 
-    shows = ("design", "measured", "data message", "fit")
+    shows = ("design", "measured", "fit")
 
-    def __init__(self, state: ExplorerState, **params):
-        super().__init__(state, **params)
+    fit = param.ClassSelector(class_=FitState, doc="The session's fit of the measured data.")
+
+    def __init__(self, state: ExplorerState, fit: FitState, **params):
+        super().__init__(state, fit=fit, **params)
         self.stiffness_file = csv_dropper(multiple=True)
         self.loop_file = csv_dropper()
         on_files(self.stiffness_file, state.load_measured_files)
@@ -50,16 +55,16 @@ class MeasuredView(PlotView):
                                             description="Global fit to all loaded data from 8 starting points; "
                                             "the current design is the first.")
         self.fit_button.on_click(self._fit)
-        self.method = pn.widgets.RadioButtonGroup.from_param(state.param.fit_method, description=state.param.fit_method.doc)
-        self.fit_on = pn.widgets.TextInput.from_param(state.param.fit_on, description=state.param.fit_on.doc,
+        self.method = pn.widgets.RadioButtonGroup.from_param(fit.param.fit_method, description=fit.param.fit_method.doc)
+        self.fit_on = pn.widgets.TextInput.from_param(fit.param.fit_on, description=fit.param.fit_on.doc,
                                                       placeholder="mode=axial,amplitude=1e-4", max_length=500,
                                                       sizing_mode="stretch_width")
         self.sweep = pn.widgets.Select(label="Sweep amplitude (two-step)", options={}, sizing_mode="stretch_width",
-                                       description=state.param.sweep_amplitude.doc)
-        self.sweep.param.watch(lambda e: setattr(state, "sweep_amplitude", e.new), "value")
+                                       description=fit.param.sweep_amplitude.doc)
+        self.sweep.param.watch(lambda e: setattr(fit, "sweep_amplitude", e.new), "value")
         self.use = pn.widgets.Button(label="Use the fitted design in the explorer", color="success",
                                      disabled=True)
-        self.use.on_click(lambda _e: state.use_fit())
+        self.use.on_click(lambda _e: fit.use_fit())
         self.download = pn.widgets.FileDownload(callback=self._fitted_json, filename="bushing-fitted.json",
                                                 label="Fitted design file (JSON)", disabled=True,
                                                 sizing_mode="stretch_width")
@@ -67,9 +72,24 @@ class MeasuredView(PlotView):
         self.summary = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.results = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.prediction = pn.pane.HoloViews(None, sizing_mode="stretch_width", visible=False, linked_axes=False)
-        self._prediction_key = None
         self.residuals: LivePlot | None = None
+        self._show_message()
+        self._show_prediction()
         self.draw()
+
+    @param.depends("state.data_message", watch=True)
+    def _show_message(self):
+        """What was wrong with the last file (or fit), if anything."""
+        m = self.state.data_message
+        self.message.object = f'<div class="data-error" style="color:#b03a2e">⚠ {m}</div>' if m else ""
+
+    @param.depends(*FIT_DEPENDS, watch=True)
+    def _show_prediction(self):
+        """A fit on a subset against every measured row: a function of the fit and the data only
+        (not of the design shown), so drawn when either changes."""
+        data = curves.prediction_misfit(self.fit.fit_result, self.state.measured)
+        self.prediction.visible = data is not None
+        self.prediction.object = None if data is None else prediction_overlay(data)
 
     def frame(self, quantity: str, against: str):
         """What a residual plot shows now (``quantity`` "magnitude" or "loss")."""
@@ -84,18 +104,16 @@ class MeasuredView(PlotView):
         self.fit_button.loading = True
         try:
             # computed in a worker (the server stays responsive), stored here in the session
-            self.state.store_fit(await asyncio.to_thread(self.state.try_fit))
+            self.fit.store_fit(await asyncio.to_thread(self.fit.try_fit))
         finally:
             self.fit_button.loading = False
 
     def _fitted_json(self):
-        r = self.state.fit_result
+        r = self.fit.fit_result
         return io.StringIO(r.to_json() if r is not None else "")
 
     def _update(self):
         s = self.state
-        self.message.object = (f'<div class="data-error" style="color:#b03a2e">⚠ {s.data_message}</div>'
-                               if s.data_message else "")
         mode = s.design.mode
         unit = units.amplitude_unit(mode)
         points = curves.measured_points(s.measured, mode)
@@ -125,16 +143,10 @@ class MeasuredView(PlotView):
         options = {f"{units.display_amplitude(a, mode):.4g} {unit}": a for a in measured_amplitudes(s.measured)}
         if options != self.sweep.options:
             self.sweep.options = options
-        self.sweep.visible = s.fit_method == "two-step"
-        r = s.fit_result
+        self.sweep.visible = self.fit.fit_method == "two-step"
+        r = self.fit.fit_result
         self.use.disabled = self.download.disabled = r is None
         self.results.object = self._results_table(r) if r is not None else ""
-        key = (id(r), id(s.measured))  # depends on the fit and the data only, not on the design shown
-        if key != self._prediction_key:
-            self._prediction_key = key
-            data = curves.prediction_misfit(r, s.measured)
-            self.prediction.visible = data is not None
-            self.prediction.object = None if data is None else prediction_overlay(data)
 
     def _draw(self, points, residuals):
         dims = self.dims_for(self.state.design.mode)

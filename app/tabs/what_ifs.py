@@ -13,7 +13,9 @@ from core.parameters import BY_NAME, GEOMETRY, NAMES
 from core.whatif.sensitivity import elasticities, ranked, sentence
 from core.whatif.tolerance import ToleranceError
 
-from .. import units
+from .. import curves, units
+from ..bands import band_tolerances, banded
+from ..fit_state import FitState
 from ..inputs import FloatInput, IntInput
 from ..live import LivePlot
 from ..plotting.what_ifs import sensitivity_bars
@@ -50,11 +52,13 @@ the targets file to repeat it there.
 class WhatIfView(PlotView):
     """Tolerances, sensitivities, targets."""
 
-    shows = ("design", "frequency", "amplitude")
+    shows = ("design", "frequency", "amplitude", "sweep range", "bands")  # the bars, and the bands' status
 
-    def __init__(self, state: ExplorerState, **params):
+    fit = param.ClassSelector(class_=FitState, doc="The session's fit (its covariance may make the bands).")
+
+    def __init__(self, state: ExplorerState, fit: FitState, **params):
         self._showing = False
-        super().__init__(state, **params)
+        super().__init__(state, fit=fit, **params)
         self.tolerance_inputs = {
             n: FloatInput(label=f"{BY_NAME[n].label} ± %", value=self._shown_tolerances().get(n, 0.0), start=0.0,
                                      end=89.0, step=0.5, width=170)
@@ -82,7 +86,6 @@ class WhatIfView(PlotView):
         self.result = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.targets_file = pn.widgets.FileDownload(callback=self._targets_file, filename="bushing-targets.json",
                                                     label="Targets file (JSON)", width=200)
-        self._on_band()
         self.draw()
 
     # ---- tolerances ------------------------------------------------------------------------------
@@ -111,16 +114,26 @@ class WhatIfView(PlotView):
         finally:
             self._showing = False
 
-    @param.depends("state.band_message", "state.band_on", "state.fit_result", "state.band_from_fit", watch=True)
-    def _on_band(self):
+    def _show_band(self):
+        """The bands' status, from the values (:func:`app.bands.band_tolerances`; the
+        explorer's and the card's bands, cached, say why a band cannot be computed)."""
         s = self.state
-        if s.band_on and s.band_message:
-            self.band_status.object = f'<span style="color:#8a5300">No band: {s.band_message}</span>'
+        fit = self.fit.fit_result
+        tolerances = band_tolerances(**s.band_inputs(), fit_result=fit)
+        design, f, x = s.design, s.frequency_hz, s.amplitude
+        _, reason = banded(tolerances, lambda tol: curves.operating_bands(design, f, x, s.freq_range, tol))
+        if not reason:
+            try:
+                _, reason = banded(tolerances, lambda tol: curves.card_bands(design, f, tol))
+            except ValueError:  # no card for this design: its tab says so
+                pass
+        if s.band_on and reason:
+            self.band_status.object = f'<span style="color:#8a5300">No band: {reason}</span>'
         elif s.band_on:
             self.band_status.object = "Bands are drawn on the Explorer's stiffness plots and in Every direction."
         else:
             self.band_status.object = ""
-        if s.band_from_fit and s.fit_result is None:
+        if s.band_from_fit and fit is None:
             self.band_status.object = ('<span style="color:#8a5300">No fit yet: fit measured data first '
                                        "(Measured data and fit).</span>")
 
@@ -132,6 +145,7 @@ class WhatIfView(PlotView):
         return elasticities(s.design, s.frequency_hz, float(units.to_si_amplitude(s.amplitude, s.design.mode)))
 
     def _update(self):
+        self._show_band()
         values = self.sensitivities()
         items = []
         for quantity, label, color in (("magnitude", "∂ln|K| / ∂ln p", "#1f5f8b"),
