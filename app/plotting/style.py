@@ -162,6 +162,13 @@ def _thaw(value):
     return value
 
 
+# the elements made of columns, and how they hold them: as a dict of arrays. HoloViews would try a
+# pandas DataFrame first; measured here, a 200-point curve is then made in 0.76 ms instead of
+# 0.52 ms and read back (dimension_values) in 0.21 ms instead of 0.16 ms, on every change
+TABULAR = ("Curve", "Scatter", "Area")
+TABULAR_DATA = ["dictionary"]
+
+
 def styled(kind: str, data, **options):
     """An element of ``kind`` holding ``data``, cloned from a template that carries ``options``
     (one options entry per style, whatever the number of frames)."""
@@ -172,6 +179,8 @@ def styled(kind: str, data, **options):
         options.setdefault("muted_alpha", 0.0)
     key = tuple(sorted((k, _freeze(v)) for k, v in options.items() if k not in ("kdims", "vdims", "label")))
     fields = {k: options[k] for k in ("kdims", "vdims", "label") if k in options}
+    if kind in TABULAR:
+        fields["datatype"] = TABULAR_DATA
     return template(kind, key).clone(data, **fields)
 
 
@@ -199,10 +208,19 @@ def overlay(items, title, png, *, logx=False, logy=False, legend="right", height
     return styled("Overlay", list(items), **options)
 
 
+@functools.cache
+def _band_top(name: str, label: str, unit: str | None) -> hv.Dimension:
+    """The dimension of a band's top edge (one per quantity, never changed)."""
+    return hv.Dimension(f"{name}_upper", label=f"{label} (band top)", unit=unit)
+
+
+MARKER_Y = hv.Dimension("y")  # a marker's vertical extent (never changed, never drawn on an axis)
+
+
 def band_area(x, low, high, xdim: hv.Dimension, ydim: hv.Dimension, label: str, color: str):
     """A tolerance band: the area between ``low`` and ``high``."""
     # its own label: HoloViews finds a dimension by its label, and two alike would both read the lower
-    upper = hv.Dimension(f"{ydim.name}_upper", label=f"{ydim.label} (band top)", unit=ydim.unit)
+    upper = _band_top(ydim.name, ydim.label, ydim.unit)
     return styled("Area", (np.asarray(x, dtype=float), np.asarray(low, dtype=float), np.asarray(high, dtype=float)),
                   kdims=[xdim], vdims=[ydim, upper], label=label, color=color, fill_alpha=0.22, line_alpha=0.0,
                   tools=["hover"])
@@ -215,7 +233,7 @@ def band_label(percentiles) -> str:
 
 def marker(x: float, dim: hv.Dimension):
     """The operating point: a dotted vertical line at ``x``."""
-    return styled("VLine", float(x), kdims=[dim, hv.Dimension("y")], color=OPERATING_COLOR,
+    return styled("VLine", float(x), kdims=[dim, MARKER_Y], color=OPERATING_COLOR,
                   line_dash="dotted", line_width=1.5)
 
 
