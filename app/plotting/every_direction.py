@@ -31,6 +31,7 @@ def card_dimensions() -> dict[str, hv.Dimension]:
         "loss": hv.Dimension("card_loss", label="Loss factor"),
     }
 
+
 def card_overlays(data: dict, dims: dict, at: dict) -> dict:
     """The card (:func:`app.curves.card_sweeps`) as four plots: |K| and the loss factor of the
     translations against displacement, of the rotations against angle; ``at`` the card's
@@ -49,6 +50,7 @@ def card_overlays(data: dict, dims: dict, at: dict) -> dict:
             label = title if quantity == "magnitude" else f"Loss factor, {title[4:]}"
             out[name] = overlay(items, label, f"bushing-card-{name.replace('_', '-')}", logx=True, height=260)
     return out
+
 
 def card_plots(design: Design, frequency_hz: float = 10.0, displacement: float = 1e-4, angle: float = 0.01, *,
                width: int | None = 800) -> hv.Layout:

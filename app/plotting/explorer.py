@@ -38,12 +38,14 @@ TITLES = {
     ("loss_factor", "amplitude"): "Loss factor against amplitude",
 }
 
+
 LOOP_TITLE = "Hysteresis loop at the operating point"
 
 def strain_label(ratio: float) -> str:
     """The legend of a frequency sweep: its equivalent strain as a multiple of ε½ (the same for
     every design, so a legend never changes while the design does)."""
     return "ε̂ = ε½" if ratio == 1 else f"ε̂ = {ratio:g} ε½"
+
 
 def loop_overlay(lp: dict, dims: dict, *, reference: dict | None = None, measured: dict | None = None,
                  title: str = LOOP_TITLE) -> hv.Overlay:
@@ -60,6 +62,7 @@ def loop_overlay(lp: dict, dims: dict, *, reference: dict | None = None, measure
                              alpha=0.5, size=4))
     return overlay(items, title, "bushing-hysteresis-loop", legend="top_left", height=330)
 
+
 def sweep_curves(quantity: str, against: str, sweep: dict, dims: dict, labels) -> list:
     """One curve per swept value: |K| or the loss factor against frequency (a row per
     amplitude) or against amplitude (a row per frequency)."""
@@ -67,6 +70,7 @@ def sweep_curves(quantity: str, against: str, sweep: dict, dims: dict, labels) -
     palette = SWEEP_PALETTES["amplitude" if against == "frequency" else "frequency"]
     return [curve(x, row, dims[against], dims[quantity], label, color=palette[i % len(palette)], line_width=1.3)
             for i, (row, label) in enumerate(zip(sweep[quantity], labels))]
+
 
 def sweep_overlay(quantity: str, against: str, sweep_items: list, dims: dict, *, operating: dict,
                   at: float, reference: dict | None = None, measured: dict | None = None,
@@ -89,6 +93,7 @@ def sweep_overlay(quantity: str, against: str, sweep_items: list, dims: dict, *,
     items.append(marker(at, xdim))
     return overlay(items, TITLES[(quantity, against)], f"bushing-{quantity}-vs-{against}",
                    logx=against == "amplitude")
+
 
 @functools.lru_cache(maxsize=64)
 def sweep_layer(design: Design, freq_range: tuple[float, float], quantity: str, against: str,

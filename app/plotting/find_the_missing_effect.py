@@ -34,6 +34,7 @@ def gap_bars(stages: dict, dims: dict) -> hv.Overlay:
     return overlay(items, "Gap (relative RMS misfit of complex stiffness) after each step", "bushing-diagnosis-gap",
                    legend=None, height=230)
 
+
 def diagnosis_curves(groups: list, dims: dict) -> dict:
     """Data (points) against the baseline (dashed) and the final model (solid), one colour per
     amplitude, for |K| and the loss factor (``groups`` as
@@ -55,6 +56,7 @@ def diagnosis_curves(groups: list, dims: dict) -> dict:
                                 f"bushing-diagnosis-{quantity}", legend=None, height=280)
     return out
 
+
 def misfit_map(m: dict, column: str, title: str, dims: dict, limit: float, png: str) -> hv.Overlay:
     """A misfit over the (frequency, amplitude) plane: one square per measured point, coloured
     on a diverging scale from −``limit`` to +``limit`` (red: model above the data)."""
@@ -65,6 +67,7 @@ def misfit_map(m: dict, column: str, title: str, dims: dict, limit: float, png: 
                  marker="square", size=11, colorbar=True, line_color="#777777", line_width=0.5,
                  clim=(-limit, limit), tools=["hover"])
     return overlay([pts], title, png, logy=True, legend=None, height=260)
+
 
 def diagnosis_overlays(diagnosis) -> dict:
     """The plots of a :class:`core.identify.diagnose.Diagnosis`: ``"gap"`` (one plot: the gap after each
@@ -87,6 +90,7 @@ def diagnosis_overlays(diagnosis) -> dict:
                                    f"bushing-misfit-{which}-{MISFIT_PNG[column]}"))
     return {"gap": [gap_bars(stages, dims)], "curves": list(diagnosis_curves(groups, dims).values()),
             "maps": maps, "groups": groups}
+
 
 def diagnosis_plots(diagnosis, *, width: int | None = 560) -> hv.Layout:
     """The plots of a diagnosis: the gap after each step, the curves, the misfit maps.

@@ -40,6 +40,7 @@ def branch_overlays(data: dict, dims: dict, at: float) -> dict:
         out[which] = overlay(areas, title, f"bushing-branches-{which}", logx=True, legend="top_left")
     return out
 
+
 def loop_shape_overlay(lp: dict, dims: dict, title: str = "Loop shape during the amplitude sweep") -> hv.Overlay:
     """A loop scaled to its peak drive and peak force, branch by branch: its shape alone."""
     x = lp["displacement"] / np.max(np.abs(lp["displacement"]))
@@ -51,6 +52,7 @@ def loop_shape_overlay(lp: dict, dims: dict, title: str = "Loop shape during the
     items += [curve(x, lp[f"force_{name}"] / peak, xd, fd, name, color=color, line_width=1.5)
               for name, color in BRANCH_COLORS.items()]
     return overlay(items, title, "bushing-loop-shape", legend="top_left", height=420)
+
 
 def branch_plots(design: Design, frequency_hz: float = 10.0, amplitude: float | None = None, n: int = 80, *,
                  width: int | None = 600) -> hv.Layout:

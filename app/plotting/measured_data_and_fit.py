@@ -38,6 +38,7 @@ def residual_overlays(points: dict | None, residuals: dict | None, dims: dict) -
                 height=240)
     return out
 
+
 def prediction_overlay(data: dict) -> hv.Overlay:
     """A fit on a subset predicting the rest (:func:`app.curves.prediction_misfit`): the |K|
     misfit of every mode against frequency, fitted rows filled, predicted rows hollow."""
@@ -52,6 +53,7 @@ def prediction_overlay(data: dict) -> hv.Overlay:
                 items.append(scatter(part["frequency_hz"], part["misfit_pct"], xdim, ydim,
                                      f"{mode}, {which}", color=color, fill_alpha=fill, line_color=color, size=6))
     return overlay(items, "Fitted and predicted rows, every mode: |K| misfit", "bushing-prediction", height=300)
+
 
 def residual_plots(design: Design, measured: MeasuredStiffness, *, width: int | None = 500) -> hv.Layout:
     """The residuals of ``design`` against measured stiffness: model − measured.

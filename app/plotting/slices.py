@@ -20,6 +20,7 @@ SLICE_COLORS = {1: "#1f77b4", 2: "#ff7f0e", 3: "#2ca02c", "continuum": "#9467bd"
 
 SLICE_NAMES = {1: "1 slice (eqs 17/18)", 2: "2 slices", 3: "3 slices", "continuum": "continuum"}
 
+
 def slices_overlays(data: dict, dims: dict, at: float) -> dict:
     """Paper A's comparison (:func:`app.curves.slice_comparison`) as three plots against
     amplitude: |K|, its difference from the single modulus in %, and the loss factor."""
@@ -36,6 +37,7 @@ def slices_overlays(data: dict, dims: dict, at: float) -> dict:
         items.append(marker(at, dims["amplitude"]))
         out[which] = overlay(items, title, f"bushing-slices-{which}", logx=True, height=280)
     return out
+
 
 def slices_plots(design: Design, frequency_hz: float = 10.0, amplitude: float | None = None, n: int = 60, *,
                  width: int | None = 800) -> hv.Layout:

@@ -34,6 +34,7 @@ def sweep_label(value, unit) -> str:
 
 BRANCH_COLORS = {"elastic": "#1f77b4", "viscoelastic": "#2ca02c", "friction": "#d62728"}
 
+
 REFERENCE_STYLE = {"color": "#444444", "line_dash": "dashed", "line_width": 2}
 
 MEASURED_STYLE = {"color": "#222222", "alpha": 0.6, "size": 5}

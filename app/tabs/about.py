@@ -15,6 +15,7 @@ def _keys(names, last: str = ", ") -> str:
 _DIMENSIONED = [n for n in MATERIAL if BY_NAME[n].unit.si != "–"]
 _PLAIN = [n for n in MATERIAL if BY_NAME[n].unit.si == "–"]
 
+
 ABOUT = f"""
 ### Bushing Explorer
 

@@ -23,6 +23,7 @@ from ..uploads import csv_dropper, on_upload
 
 log = logging.getLogger("bushing.app")
 
+
 INTRO = """
 **Where do model and measurement disagree, and what is missing?** Load measured dynamic stiffness
 (or a *mystery* data set with an effect hidden in it), choose the branches of the starting model,
@@ -32,6 +33,7 @@ names the one the data support (by the Bayesian information criterion, with a th
 not add effects to fit noise, and only if it explains most of the misfit), adds it, refits, and
 repeats until what is left is noise, or says what remains unexplained.
 """
+
 
 PROGRESS_POLL_S = 0.15
 

@@ -26,6 +26,7 @@ to watch the loop change shape: a thin ellipse at small amplitude, a fat frictio
 knee, a sheared parallelogram at large amplitude.
 """
 
+
 WHICH = ("real", "loss")
 
 

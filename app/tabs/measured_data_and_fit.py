@@ -30,6 +30,7 @@ RESIDUALS = (("magnitude", "frequency"), ("loss", "frequency"), ("magnitude", "a
 
 log = logging.getLogger("bushing.app")
 
+
 FITTED = " and ".join([", ".join(BY_NAME[p].symbol for p in MATERIAL[:-1]), BY_NAME[MATERIAL[-1]].symbol])
 
 

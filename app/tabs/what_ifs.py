@@ -27,6 +27,7 @@ A, _B, L, MU = (BY_NAME[n] for n in (*GEOMETRY, "shear_modulus"))
 # a found design's columns: its geometry and µ (what a search changes), each to its digits
 FOUND_COLUMNS = {**{n: ".3f" for n in GEOMETRY}, L.name: ".2f", MU.name: ".4g"}
 
+
 TOLERANCE_TEXT = """
 **Tolerance bands.** Give each parameter's tolerance (± % of its value) and switch the bands on:
 every stiffness plot of the Explorer (and the Every direction tab) shows the 5–95 % band of the
