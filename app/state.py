@@ -1,9 +1,13 @@
 """The explorer's state: one parameterized design session, with no Panel import.
 
-Parameters are in the units engineers read (mm, MPa, kPa, Hz; the drive amplitude in mm axially
-and rad in torsion); :attr:`ExplorerState.design` is the last *valid* core design in SI, and
-:attr:`ExplorerState.errors` says, field by field, what is wrong with the current input. Plots
-draw from the data methods below, which ask the (cached) core; nothing here draws.
+Values only. The inputs are in the units engineers read (mm, MPa, kPa, Hz; the drive amplitude in
+mm axially and rad in torsion). Computed from them, read-only, in one update per change
+(:meth:`ExplorerState._derive`): :attr:`ExplorerState.design`, the last *valid* core design in SI;
+:attr:`ExplorerState.errors`, field by field, what is wrong with the current input;
+:attr:`ExplorerState.freq_range`, the sweeps' valid range. The views (:mod:`app.tabs`) read these
+values and call the pure functions of :mod:`app.curves`; :data:`SHOWN` names what each of them
+draws. The fit workflow has its own state (:mod:`app.fit_state`), the what-if targets form its own
+(:mod:`app.targets_form`); nothing here draws, and no view writes here while it draws.
 """
 
 from __future__ import annotations
