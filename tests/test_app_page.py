@@ -185,7 +185,7 @@ def test_the_state_and_the_curves_need_no_panel_and_no_plotting():
     import subprocess
     import sys
 
-    code = ("import sys, app.state, app.curves, app.diagnosis_state; "
+    code = ("import sys, app.state, app.curves, app.diagnosis_state, app.fit_state, app.targets_form, app.bands; "
             "print(sorted(m for m in ('panel', 'holoviews', 'bokeh') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
