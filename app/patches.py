@@ -43,6 +43,13 @@ list ``value``: every typed or dragged number is processed at once. That is 50 m
 by construction, and it is also correct behaviour: with the debounce, a click right after typing
 (the design form's "Find designs") was processed before the typed value, on the old one.
 
+**One message per change** (:func:`hold_each_change`). On a server, Panel processes a change from
+the page (``Syncable._change_event``) without holding the document: each property the change sets
+goes to the page as its own message, as it is set. A mode switch then painted the amplitude
+slider in the new mode's unit beside the operating point's text in the old one for some 13
+frames, until the plots were computed (a browser test samples every frame). Held, everything
+a change sets arrives in one message and is painted at once.
+
 **Data-only updates** (:func:`holoviews_plots`, :func:`written`). HoloViews builds each plot
 (its dimensions, styles, legend, linked axes, tap stream); a later frame with the same elements
 (kinds, labels, styles, dimensions) differs only in its numbers, and those are written into the
@@ -64,12 +71,14 @@ import weakref
 
 import numpy as np
 from panel.io import resources as panel_resources
+from panel.io.document import hold as panel_hold
 from panel.models.markup import HTML as PanelHTML
 from panel.reactive import Syncable
 
 MATH_DELIMITERS = re.compile(r"\$\$|\\\(|\\\[")
 # the Panel internals the hooks replace or extend are there (a test fails if not)
-PATCHED = hasattr(panel_resources, "_panel_use_mathjax") and hasattr(Syncable, "_priority_changes")
+PATCHED = (hasattr(panel_resources, "_panel_use_mathjax") and hasattr(Syncable, "_priority_changes")
+           and hasattr(Syncable, "_change_event"))
 _installed = False
 _pages = weakref.WeakSet()  # documents that have the BokehJS patches
 
@@ -85,6 +94,7 @@ def install(doc=None) -> None:
         from .inputs import IMMEDIATE
 
         send_values_at_once(IMMEDIATE)
+        hold_each_change()
         _installed = True
     if doc is not None and doc not in _pages and os.environ.get("BUSHING_BOKEHJS_PATCHES", "1") == "1":
         install_bokehjs_patches(doc)
@@ -97,6 +107,23 @@ def send_values_at_once(classes) -> None:
     for cls in classes:
         if "value" not in cls._priority_changes:
             cls._priority_changes = [*cls._priority_changes, "value"]  # the class's own list
+
+
+def hold_each_change() -> None:
+    """Every change of a widget's property from the page processed under one document hold
+    (``Syncable._change_event``, where Panel processes them on a server): what the change sets
+    anywhere (the widget's own label and bounds, the other widgets, the texts, the plots) goes to
+    the page in one message, painted at once (see the module)."""
+    original = Syncable._change_event
+    if getattr(original, "held_by_bushing", False):
+        return
+
+    def _change_event(self, doc):
+        with panel_hold(doc):
+            original(self, doc)
+
+    _change_event.held_by_bushing = True
+    Syncable._change_event = _change_event
 
 
 def holds_math(roots) -> bool:
