@@ -30,6 +30,14 @@ are active and still behave as Bokeh's own code. Measured on the HoloViews explo
 A/B twice: Chromium's renderer 59–60 ms per change with them, 71–82 ms without; median latency
 141–144 ms against 156–164 ms. ``BUSHING_BOKEHJS_PATCHES=0`` leaves them out, to measure again.
 
+**Models from the server are known to it** (:data:`BOKEHJS_SERVER_MODELS`, run in every page).
+BokehJS 3.9 counts a model that a server patch brings (a tab's content shown for the first time) as
+new to the server until the page sends its next patch, and that patch sends the model again in
+full: the server warns ``reference already known`` (``BokehUserWarning``), e.g. on the first click
+in the diagnosis tab, whose widgets arrive with the tab and which draws no plot (a plot's first
+paint sends a patch and hides it elsewhere). The page takes the models of each server patch as
+known: a model the page makes itself stays new.
+
 **MathJax.** Panel 1.9 sends Bokeh's MathJax bundle (1.8 MB, the largest script of the page) whenever the
 page holds an HTML pane, in case one holds math (holoviz/panel#8424; holoviz/panel#8179 would
 load it late instead). The explorer's texts hold none: the bundle is sent only to a page whose
@@ -86,7 +94,8 @@ _pages = weakref.WeakSet()  # documents that have the BokehJS patches
 def install(doc=None) -> None:
     """Put the hooks of this module in place, each once however often it is called: the MathJax
     decision and the number edits without debounce (process-wide), and the BokehJS paint patches
-    in the page of ``doc`` (if given, unless ``BUSHING_BOKEHJS_PATCHES=0``)."""
+    in the page of ``doc`` (if given, unless ``BUSHING_BOKEHJS_PATCHES=0``), and
+    :data:`BOKEHJS_SERVER_MODELS` in it (if given)."""
     global _installed
     if not _installed:
         if hasattr(panel_resources, "_panel_use_mathjax"):
@@ -96,8 +105,12 @@ def install(doc=None) -> None:
         send_values_at_once(IMMEDIATE)
         hold_each_change()
         _installed = True
-    if doc is not None and doc not in _pages and os.environ.get("BUSHING_BOKEHJS_PATCHES", "1") == "1":
-        install_bokehjs_patches(doc)
+    if doc is not None and doc not in _pages:
+        if os.environ.get("BUSHING_BOKEHJS_PATCHES", "1") == "1":
+            install_bokehjs_patches(doc)
+        from bokeh.models import CustomJS
+
+        doc.js_on_event("document_ready", CustomJS(code=BOKEHJS_SERVER_MODELS))
         _pages.add(doc)
 
 
@@ -207,6 +220,38 @@ patch("bushingGlyphPosition", "inline-style", "models/renderers/glyph_renderer",
       style.display = "none"
     }
   })
+"""
+
+
+BOKEHJS_SERVER_MODELS = """
+// window.bushingServerModels: "known" once patched, "unpatched" if BokehJS has no such internals
+if (window.bushingServerModels == null) {
+  const mod = Bokeh.require("document")
+  const proto = mod != null && mod.Document != null ? mod.Document.prototype : null
+  const doc = Bokeh.documents[0]
+  if (proto != null && typeof proto.apply_json_patch === "function" && doc != null && doc._new_models instanceof Set) {
+    // the ids of the models a patch defines ({type: "object", id, ...} anywhere in its events)
+    const defined = (value, ids) => {
+      if (Array.isArray(value)) {
+        for (const v of value) if (v !== null && typeof v === "object") defined(v, ids)
+      } else if (value !== null && typeof value === "object" && !ArrayBuffer.isView(value)
+                 && !(value instanceof ArrayBuffer)) {
+        if (value.type === "object" && typeof value.id === "string") ids.add(value.id)
+        for (const v of Object.values(value)) if (v !== null && typeof v === "object") defined(v, ids)
+      }
+      return ids
+    }
+    const apply = proto.apply_json_patch
+    proto.apply_json_patch = function (patch, buffers) {
+      apply.call(this, patch, buffers)
+      const ids = defined(patch.events, new Set())
+      for (const model of [...this._new_models]) if (ids.has(model.id)) this._new_models.delete(model)
+    }
+    window.bushingServerModels = "known"
+  } else {
+    window.bushingServerModels = "unpatched"
+  }
+}
 """
 
 

@@ -90,4 +90,4 @@ def test_the_bokehjs_patches_go_into_a_page_once():
     patches.install(doc)
     patches.install(doc)
     callbacks = doc.callbacks._js_event_callbacks.get("document_ready", [])
-    assert [c.code for c in callbacks] == [patches.BOKEHJS_PAINT_PATCHES]
+    assert [c.code for c in callbacks] == [patches.BOKEHJS_PAINT_PATCHES, patches.BOKEHJS_SERVER_MODELS]

@@ -132,7 +132,7 @@ def test_the_explorer_reads_several_files_and_predicts_the_other_modes():
     assert r.prediction["points_fitted"] == 30 and r.prediction["gap_held_out"] < 3 * NOISE
     assert "**Fitted on mode=axial** (30 points)" in app.measured.results.object
     assert "| radial | " in app.measured.results.object and "predicted" in app.measured.results.object
-    assert app.measured.prediction.visible
+    assert app.measured.prediction_box.visible
     shown = {el.label: el for el in app.measured.prediction.object}
     assert set(shown) == {"axial, fitted", "radial, predicted"}
     read = s.measured.select(s.measured.mode == "radial")  # as read from the file

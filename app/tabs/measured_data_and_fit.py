@@ -72,7 +72,11 @@ class MeasuredView(PlotView):
         self.message = pn.pane.HTML("", sizing_mode="stretch_width")
         self.summary = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.results = pn.pane.Markdown("", sizing_mode="stretch_width")
-        self.prediction = pn.pane.HoloViews(None, sizing_mode="stretch_width", visible=False, linked_axes=False)
+        self.prediction = pn.pane.HoloViews(None, sizing_mode="stretch_width", linked_axes=False)
+        # shown and hidden through its box: Panel 1.9 passes a HoloViews pane's own layout changes
+        # (``visible``) on to the Bokeh pane inside it, with its ``design``, which a figure does not
+        # take (AttributeError, and the change lost)
+        self.prediction_box = pn.Column(self.prediction, visible=False, sizing_mode="stretch_width")
         self.residuals: LivePlot | None = None
         self._show_message()
         self._show_prediction()
@@ -89,7 +93,7 @@ class MeasuredView(PlotView):
         """A fit on a subset against every measured row: a function of the fit and the data only
         (not of the design shown), so drawn when either changes."""
         data = curves.prediction_misfit(self.fit.fit_result, self.state.measured)
-        self.prediction.visible = data is not None
+        self.prediction_box.visible = data is not None
         self.prediction.object = None if data is None else prediction_overlay(data)
 
     def frame(self, quantity: str, against: str):
@@ -210,7 +214,7 @@ class MeasuredView(PlotView):
             pn.Row(self.fit_button, self.use),
             self.download,
             self.results,
-            self.prediction,
+            self.prediction_box,
             self.residuals.grid(2),
             sizing_mode="stretch_width",
         )
