@@ -244,6 +244,7 @@ if (window.bushingServerModels == null) {
     const apply = proto.apply_json_patch
     proto.apply_json_patch = function (patch, buffers) {
       apply.call(this, patch, buffers)
+      if (this._new_models.size == 0) return  // nothing the page counts as new: nothing to look for
       const ids = defined(patch.events, new Set())
       for (const model of [...this._new_models]) if (ids.has(model.id)) this._new_models.delete(model)
     }
