@@ -252,7 +252,6 @@ class ExplorerData:
 
     design: Design
     freq_range: tuple[float, float]
-    mode: str
     frequency_hz: float
     amplitude: float
     sweeps: dict  # "frequency": frequency_sweep at the sweep amplitudes; "amplitude": amplitude_sweep
@@ -264,6 +263,10 @@ class ExplorerData:
     measured_loop: dict | None  # measured_loop_points
     ranges: dict  # axis name → (start, end), shared by every plot of that quantity
     bands: dict | None = None  # operating_bands, when tolerances are set
+
+    @property
+    def mode(self) -> str:
+        return self.design.mode
 
 
 def operating_bands(design: Design, frequency_hz: float, amplitude: float, freq_range, tolerances,
@@ -359,7 +362,7 @@ def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq
                                     + ([loop_points["displacement"]] if loop_points else []))
     ranges["force"] = padded([lp["force"], lp["force_elastic"], lp["force_viscoelastic"], lp["force_friction"]]
                              + ([ref_loop["force"]] if ref_loop else []) + ([loop_points["force"]] if loop_points else []))
-    return ExplorerData(design=design, freq_range=(float(freq_range[0]), float(freq_range[1])), mode=mode,
+    return ExplorerData(design=design, freq_range=(float(freq_range[0]), float(freq_range[1])),
                         frequency_hz=frequency_hz, amplitude=amplitude, sweeps=sweeps,
                         operating=operating, references=references, measured=points, loop=lp,
                         reference_loop=ref_loop, measured_loop=loop_points, ranges=ranges, bands=bands)

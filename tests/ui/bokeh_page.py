@@ -4,6 +4,8 @@ Every wait is ``page.wait_for_function`` on a condition read in the page: the do
 idle, a figure's data, a span or a legend changed, a text shown. A test waits for the state it
 then checks, never for a fixed time."""
 
+import re
+
 # the figure of the document with this title (or null)
 FIGURE_JS = """(title) => [...Bokeh.documents[0].all_models].find(
     m => m.type === 'Figure' && m.title && m.title.text === title) ?? null"""
@@ -156,3 +158,16 @@ def tap(canvas, x_fraction: float):
     """One click on ``canvas`` at ``x_fraction`` of its width, half its height."""
     box = canvas.bounding_box()
     canvas.click(position={"x": box["width"] * x_fraction, "y": box["height"] * 0.5})
+
+
+def mystery_demo(page, url):
+    """Open the explorer, load the diagnosis tab's mystery data set, diagnose it and reveal its
+    truth (waiting for each step's answer)."""
+    open_explorer(page, url)
+    page.get_by_text("Find the missing effect", exact=True).click()
+    page.get_by_role("button", name="Load a mystery data set (demo)").click()
+    page.get_by_text("mystery data set").first.wait_for()
+    page.get_by_role("button", name="Diagnose").click()
+    page.get_by_role("button", name="Reveal the truth").wait_for(timeout=60_000)
+    page.get_by_role("button", name="Reveal the truth").click()
+    page.get_by_text(re.compile("Hidden in the data|Nothing was hidden")).wait_for()

@@ -3,7 +3,6 @@ traceback, driven in a real browser, and then no warning, no traceback in the se
 Bokeh warning raised while the server ran them. Each step waits for the state it then checks."""
 
 import gc
-import re
 import threading
 import warnings
 
@@ -11,7 +10,7 @@ import pytest
 from playwright.sync_api import expect
 
 from tests.helpers import served
-from tests.ui.bokeh_page import open_explorer
+from tests.ui.bokeh_page import mystery_demo, open_explorer
 
 pytestmark = pytest.mark.usefixtures("console_errors")
 
@@ -55,14 +54,7 @@ def test_clear_the_data_after_a_fit_with_fit_on(page, explorer_url, server_log, 
 def test_first_mystery_demo(page, explorer_url, server_log, bokeh_warnings):
     """The first click in the diagnosis tab, on a widget the server sent with the tab: the page
     refers to it by id (the server knows it), never sends it again as a new model."""
-    open_explorer(page, explorer_url)
-    page.get_by_text("Find the missing effect", exact=True).click()
-    page.get_by_role("button", name="Load a mystery data set (demo)").click()
-    page.get_by_text("mystery data set").first.wait_for()
-    page.get_by_role("button", name="Diagnose").click()
-    page.get_by_role("button", name="Reveal the truth").wait_for(timeout=60_000)
-    page.get_by_role("button", name="Reveal the truth").click()
-    page.get_by_text(re.compile("Hidden in the data|Nothing was hidden")).wait_for()
+    mystery_demo(page, explorer_url)
     assert_clean(server_log, bokeh_warnings)
 
 

@@ -9,6 +9,7 @@ import pytest
 from playwright.sync_api import expect
 
 from tests.ui.bokeh_page import (
+    mystery_demo,
     open_explorer,
     plots,
     tap,
@@ -133,14 +134,7 @@ def test_diagnose_a_hidden_effect_and_use_the_final_model(page, explorer_url, tm
 
 
 def test_mystery_demo_reveals_its_truth(page, explorer_url):
-    open_explorer(page, explorer_url)
-    page.get_by_text("Find the missing effect", exact=True).click()
-    page.get_by_role("button", name="Load a mystery data set (demo)").click()
-    page.get_by_text("mystery data set").first.wait_for()
-    page.get_by_role("button", name="Diagnose").click()
-    page.get_by_role("button", name="Reveal the truth").wait_for(timeout=60_000)
-    page.get_by_role("button", name="Reveal the truth").click()
-    page.get_by_text(re.compile("Hidden in the data|Nothing was hidden")).wait_for()
+    mystery_demo(page, explorer_url)
     assert page.get_by_text("The diagnosis found exactly that.").count() == 1
 
 
