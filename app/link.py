@@ -281,8 +281,11 @@ class UrlLink:
         state.param.watch(self._changed, [*URL_NAMES, "design", "freq_range", "reference"])
 
     def _opened(self, event):
+        """A URL the browser sets (the page's own at its start, the back button): applied, and
+        the URL then written from the state (a refused value leaves the address bar)."""
         if event.new != self._written:
             apply_link(self.state, event.new)
+            self._changed()
 
     def _changed(self, *_events):
         if self.doc is None:  # no session (a script): at once
