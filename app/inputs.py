@@ -302,7 +302,7 @@ if (navigator.clipboard && window.isSecureContext) {
 def copy_link_button() -> pn.widgets.Button:
     """A button that copies the page's link (the address bar: design, effects, reference,
     operating point, bands) to the clipboard, in the browser."""
-    button = pn.widgets.Button(label="Copy link", icon="link", color="primary", sizing_mode="stretch_width",
+    button = pn.widgets.Button(label="Copy link", color="primary", sizing_mode="stretch_width",
                                description="Copy the link of what the page shows; opened, it shows the same.")
     button.js_on_click(args={"button": button}, code=COPY_JS)
     return button

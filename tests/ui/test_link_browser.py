@@ -27,7 +27,7 @@ def reopen(page, url: str):
     open_explorer(page, url)
 
 
-def test_a_diagnosed_designs_link_reproduces_its_numbers_and_effects(page, explorer_url):
+def test_a_diagnosed_designs_link_reproduces_its_numbers_and_effects(page, explorer_url, console_errors, no_server_tracebacks):
     mystery_demo(page, explorer_url)
     page.get_by_role("button", name="Use the final model in the explorer").click()
     status = page.locator(".design-status").locator("div").first  # the design's name, mode, effects
@@ -42,7 +42,7 @@ def test_a_diagnosed_designs_link_reproduces_its_numbers_and_effects(page, explo
     expect(page.locator(SUMMARY).first).to_have_text(seen)  # the same |K| and loss factor
 
 
-def test_a_pinned_reference_survives_the_link(page, explorer_url):
+def test_a_pinned_reference_survives_the_link(page, explorer_url, console_errors, no_server_tracebacks):
     open_explorer(page, explorer_url)
     page.get_by_role("button", name="Pin as reference").click()
     expect(page.locator(".comparison")).to_contain_text("this design")
@@ -59,7 +59,7 @@ def test_a_pinned_reference_survives_the_link(page, explorer_url):
     wait_plot(page, "|K| against frequency", "p.legends.includes('reference')")
 
 
-def test_a_downloaded_design_file_opens_again_in_one_click(page, explorer_url, tmp_path):
+def test_a_downloaded_design_file_opens_again_in_one_click(page, explorer_url, tmp_path, console_errors, no_server_tracebacks):
     open_explorer(page, explorer_url + "?mu_MPa=3.1&f_Hz=40&amp=0.3")
     expect(page.locator(SUMMARY).first).to_contain_text("0.3 mm, 40 Hz")
     seen = summary(page)
@@ -86,7 +86,7 @@ def test_a_downloaded_design_file_opens_again_in_one_click(page, explorer_url, t
     expect(page.locator(SUMMARY).first).to_have_text(seen)
 
 
-def test_the_copy_button_copies_the_link(page, context, explorer_url):
+def test_the_copy_button_copies_the_link(page, context, explorer_url, console_errors, no_server_tracebacks):
     context.grant_permissions(["clipboard-read", "clipboard-write"])
     open_explorer(page, explorer_url + "?L_mm=80")
     page.wait_for_url(re.compile(r"fmin_Hz="))  # the session's link written
@@ -97,7 +97,7 @@ def test_the_copy_button_copies_the_link(page, context, explorer_url):
     assert page.evaluate("navigator.clipboard.readText()") == page.url
 
 
-def test_a_hand_edited_links_invalid_values_are_named_and_never_written_back(page, explorer_url):
+def test_a_hand_edited_links_invalid_values_are_named_and_never_written_back(page, explorer_url, console_errors, no_server_tracebacks):
     open_explorer(page, explorer_url + "?amp=1e6&mu_MPa=abc&b_mm=15&mode=diagonal&L_mm=80")
     banner = page.locator(BANNER)
     # each field with its message: the key, the value, the rule
