@@ -89,9 +89,9 @@ def test_a_downloaded_design_file_opens_again_in_one_click(page, explorer_url, t
 def test_the_copy_button_copies_the_link(page, context, explorer_url, console_errors, no_server_tracebacks):
     context.grant_permissions(["clipboard-read", "clipboard-write"])
     open_explorer(page, explorer_url + "?L_mm=80")
-    page.wait_for_url(re.compile(r"fmin_Hz="))  # the session's link written
     button = page.get_by_role("button", name="Copy link")
     expect(button).to_have_count(1)
+    page.wait_for_url(re.compile(r"fmin_Hz="))  # the session's link written
     button.click()
     expect(page.get_by_role("button", name="Link copied")).to_be_visible()
     assert page.evaluate("navigator.clipboard.readText()") == page.url
