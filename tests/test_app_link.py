@@ -124,3 +124,26 @@ def test_a_links_bad_effect_or_amplitude_is_refused_with_its_rule(session):
     assert s.errors["reference"] == "The link's ref.b_mm='35' must be larger than the inner radius a; kept none."
     flush(session)
     assert url()["amp"] == "0.1" and "effects" not in url() and "ref.a_mm" not in url()
+
+
+def test_a_design_file_downloaded_opens_again_exactly(session):
+    """The export's design file, opened in the sidebar, is the design again (name, effects,
+    exact SI values) at the operating point the user had; a broken one is named and refused."""
+    from app.inputs import DesignFile
+    from core.io.design_file import dumps_design, loads_design
+
+    app = opened("?f_Hz=40&amp=0.3")
+    s = app.state
+    s.adopt(s.design.replace(name="Mine", effects={"viscous": {"viscosity": 777.0}, "inertia": {"mass": 0.3}}))
+    saved = app.export._design_json().getvalue()
+    assert loads_design(saved) == s.design
+    shown = s.design
+    s.shear_modulus_mpa = 1.5
+    opener = DesignFile(s)
+    assert opener.load(saved.encode(), "bushing-design.json")
+    assert s.design == shown and (s.amplitude, s.frequency_hz) == (0.3, 40)
+    assert opener.load(b'{"mode": "axial"}', "broken.json") is False
+    assert opener.message.object.startswith('<div class="field-error" style="color:#b03a2e">⚠ broken.json not loaded: ')
+    assert "geometry: missing (required)" in opener.message.object and s.design == shown
+    assert opener.load(dumps_design(PAPER_B.in_mode("torsion")), "t.json")  # another mode: mid-range amplitude
+    assert s.design.mode == "torsion" and s.errors == {}
