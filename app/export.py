@@ -17,6 +17,7 @@ from core.whatif.tolerance import band, band_columns
 from .bands import band_tolerances, banded
 from .curves import amplitude_grid, fletcher_gent_amplitudes
 from .fit_state import FitState
+from .inputs import copy_link_button
 from .state import ExplorerState
 from .units import to_si_amplitude
 
@@ -52,6 +53,7 @@ class ExportView(pn.viewable.Viewer):
             callback=self._tool_file, filename=TOOL_FORMATS[self.tool_format.value][1], label="Download",
             color="default", sizing_mode="stretch_width",
         )
+        self.copy_link = copy_link_button()
         self.tool_format.param.watch(lambda e: setattr(self.tool_file, "filename", TOOL_FORMATS[e.new][1]), "value")
 
     def _design_json(self):
@@ -91,8 +93,11 @@ class ExportView(pn.viewable.Viewer):
             self.table_file,
             self.tool_format,
             self.tool_file,
+            self.copy_link,
             pn.pane.Markdown(
-                "PNG: the save icon in each plot's toolbar. Share: the address bar holds the whole "
-                "design; copy it.", sizing_mode="stretch_width", styles={"font-size": "0.9em"}),
+                "Share: the link (the address bar) holds what the page shows: the design with its "
+                "effects, the pinned reference, the operating point and the bands. The design file "
+                "opens again with **Open a design file**, above the mode. PNG: the save icon in each plot's toolbar.",
+                sizing_mode="stretch_width", styles={"font-size": "0.9em"}),
             sizing_mode="stretch_width",
         )

@@ -3,18 +3,22 @@ sliders, and the status line above the tabs. Widgets write the state; the state 
 
 from __future__ import annotations
 
+import html
 import math
 
 import panel as pn
 from bokeh.models import CustomJSTickFormatter
 
 from core.bushing import STRUCTURAL_EFFECTS, shape_factor
+from core.io.design_file import loads_design_upload
 from core.parameters import DEFAULT_SHAPE
+from core.rules import RuleError
 
 from .curves import amplitude_bounds
 from .fields import DESIGN_FIELDS, GEOMETRY_FIELDS, MATERIAL_FIELDS
 from .state import ExplorerState
 from .units import OPERATING_FREQUENCIES, amplitude_unit
+from .uploads import design_dropper, on_upload
 
 
 class FloatInput(pn.widgets.FloatInput):
@@ -145,6 +149,7 @@ class DesignInputs(pn.viewable.Viewer):
         self.amplitude = LogSlider(state, "amplitude", lambda: amplitude_bounds(state.design),
                                    lambda: amplitude_unit(state.design.mode))
         self.frequency = LogSlider(state, "frequency_hz", lambda: OPERATING_FREQUENCIES, lambda: "Hz")
+        self.design_file = DesignFile(state)
 
     def _field(self, name):
         return pn.Column(self.widgets[name], error_text(self.state, name), margin=0, sizing_mode="stretch_width")
@@ -161,12 +166,16 @@ class DesignInputs(pn.viewable.Viewer):
         material = [self._field(n) for n in MATERIAL_FIELDS]
         return pn.Column(
             self.preset,
+            self.design_file,
             self.mode,
+            error_text(self.state, "mode"),
             self.finite_length,
             self.shape_note,
             pn.pane.Markdown("**Operating point**", margin=(8, 10, 0, 10)),
             self.amplitude,
+            error_text(self.state, "amplitude"),
             self.frequency,
+            error_text(self.state, "frequency_hz"),
             pn.Card(*geometry, title="Geometry", collapsed=False, sizing_mode="stretch_width"),
             pn.Card(*material, title="Material", collapsed=False, sizing_mode="stretch_width"),
             pn.Card(self._field("freq_min"), self._field("freq_max"), title="Frequency sweep",
@@ -198,15 +207,16 @@ def status_banner(state: ExplorerState):
 
     def render(errors, design):
         if errors:
-            fields = ", ".join(state.param[n].label for n in errors if n in state.param)
+            items = "".join(f"<li><b>{html.escape(_label(state, n))}</b>: {html.escape(m)}</li>"
+                            for n, m in errors.items())
             return (
                 '<div class="input-errors" style="background:#fff3cd;border:1px solid #ffe69c;'
                 'padding:8px 12px;border-radius:6px;color:#664d03">'
-                f"Some inputs are not valid ({fields}): see the messages beside them. "
-                "The plots show the last valid design.</div>"
+                "Some inputs are not valid; the plots show the last valid design, and the link "
+                f'holds it:<ul style="margin:4px 0 0 0">{items}</ul></div>'
             )
         effects = ", ".join(design.effect_parameters) if design.effects else ""
-        name = design.name or "Custom design"
+        name = html.escape(design.name or "Custom design")
         text = f"<b>{name}</b>, {design.mode}" + (f"; effects: {effects}" if effects else "")
         structural = [e for e in design.effect_parameters if e in STRUCTURAL_EFFECTS]
         if structural:
@@ -215,4 +225,84 @@ def status_banner(state: ExplorerState):
         return text
 
     return pn.pane.HTML(pn.bind(render, state.param.errors, state.param.design),
-                        sizing_mode="stretch_width", margin=(4, 10))
+                        sizing_mode="stretch_width", margin=(4, 10), css_classes=["design-status"])
+
+
+def _label(state: ExplorerState, name: str) -> str:
+    """A field's label (its state parameter's), or its name."""
+    return state.param[name].label if name in state.param else name
+
+
+class DesignFile(pn.viewable.Viewer):
+    """Open a design file (docs/files.md, as Export writes it): a click on the drop area opens
+    the file chooser. The design is read by the core's design reader (that of ``bushing``) and
+    shown at the operating point the user had when it is in the same mode and the amplitude lies
+    on its axis (else mid-range); a refused file is named with what is wrong, and the last
+    design stays."""
+
+    def __init__(self, state: ExplorerState, **params):
+        super().__init__(**params)
+        self.state = state
+        self.dropper = design_dropper()
+        self.message = pn.pane.HTML("", sizing_mode="stretch_width", margin=(0, 10, 4, 10),
+                                    styles={"font-size": "0.9em"}, css_classes=["design-file-message"])
+        on_upload(self.dropper, self.load)
+
+    def load(self, content: bytes | str, filename: str) -> bool:
+        """Show the design file ``content`` called ``filename``; say what happened."""
+        try:
+            design, _fit = loads_design_upload(content)
+        except RuleError as exc:
+            self.message.object = (f'<div class="field-error" style="color:#b03a2e">⚠ {html.escape(filename)} '
+                                   f"not loaded: {html.escape(str(exc))}</div>")
+            return False
+        s = self.state
+        low, high = amplitude_bounds(design)
+        if design.mode == s.design.mode and low <= s.amplitude <= high:
+            s.adopt(design)
+        else:
+            s.load_design(design)
+        self.message.object = f"Loaded {html.escape(filename)}: {html.escape(design.name or 'a design')}."
+        return True
+
+    def __panel__(self):
+        return pn.Column(pn.pane.Markdown("**Open a design file** (.json, as Export writes it)",
+                                          margin=(4, 10, 0, 10)),
+                         self.dropper, self.message, margin=0, sizing_mode="stretch_width",
+                         css_classes=["design-file"])
+
+
+# copies the page's address (the link of what it shows) and says so on the button; where the
+# page is no secure context (http on another host) navigator.clipboard is missing: a selected
+# text area and the copy command instead
+COPY_JS = """
+const url = window.location.href;
+const said = (ok) => {
+  button.label = ok ? 'Link copied ✓' : 'Not copied: copy the address bar';
+  setTimeout(() => { button.label = 'Copy link'; }, 3000);
+};
+const fallback = () => {
+  const area = document.createElement('textarea');
+  area.value = url;
+  document.body.appendChild(area);
+  area.select();
+  let ok = false;
+  try { ok = document.execCommand('copy'); } catch (e) { ok = false; }
+  area.remove();
+  said(ok);
+};
+if (navigator.clipboard && window.isSecureContext) {
+  navigator.clipboard.writeText(url).then(() => said(true), fallback);
+} else {
+  fallback();
+}
+"""
+
+
+def copy_link_button() -> pn.widgets.Button:
+    """A button that copies the page's link (the address bar: design, effects, reference,
+    operating point, bands) to the clipboard, in the browser."""
+    button = pn.widgets.Button(label="Copy link", color="primary", sizing_mode="stretch_width",
+                               description="Copy the link of what the page shows; opened, it shows the same.")
+    button.js_on_click(args={"button": button}, code=COPY_JS)
+    return button

@@ -212,17 +212,27 @@ class ExplorerState(DesignFields, ToleranceBands):
         self.load_design(design)
         self.param.update(amplitude=amplitude, frequency_hz=frequency)
 
-    def apply_url_values(self, values: dict):
-        """Apply values from a shared link one by one, so one bad value spoils no other."""
-        unusable = {}
-        for name, value in values.items():
-            try:
-                self.param.update({name: value})
-            except Exception:  # noqa: BLE001 - a bad link value: keep the default, say so
-                unusable[name] = f"The link's value {value!r} was not usable; kept {getattr(self, name)!r}."
+    def apply_url_values(self, values: dict, refused: dict[str, str] | None = None):
+        """Apply values from a shared link (together; one by one if one is refused after all,
+        so that it spoils no other) and say, beside each field, why the link's ``refused`` ones
+        (field → message, :mod:`app.link`) were not applied."""
+        unusable = dict(refused or {})
+        try:
+            self.param.update(values)
+        except Exception:  # noqa: BLE001 - a value its parameter refuses: apply the others
+            for name, value in values.items():
+                try:
+                    self.param.update({name: value})
+                except Exception:  # noqa: BLE001 - keep the last value, say so
+                    unusable[name] = f"The link's value {value!r} was not usable; kept {getattr(self, name)!r}."
         if unusable:
             with param.edit_constant(self):
                 self.errors = {**self.errors, **unusable}
+
+    def name_design(self, name: str):
+        """Call the design the inputs show ``name`` (a link's), as long as they show it."""
+        self._loaded = [self.design.replace(name=name)]
+        self._derive()
 
     def pin_reference(self):
         self.reference = self.design

@@ -12,6 +12,7 @@ from collections.abc import Callable
 
 import panel as pn
 
+from core.io.design_file import MAX_DESIGN_BYTES
 from core.io.measured import MAX_BYTES
 
 CHUNK_BYTES = 4 * 1024 * 1024  # per websocket message (app.main.UPLOAD_MESSAGE_BYTES allows 16 MB)
@@ -27,6 +28,16 @@ def csv_dropper(multiple: bool = False) -> pn.widgets.FileDropper:
         accepted_filetypes=[".csv", "text/csv", "text/plain"], max_file_size=LIMIT, chunk_size=CHUNK_BYTES,
         multiple=multiple, max_files=MAX_FILES if multiple else None, previews=[], layout="compact",
         sizing_mode="stretch_width", **({"min_height": 90} if multiple else {"height": 90}),  # a list grows
+    )
+
+
+def design_dropper() -> pn.widgets.FileDropper:
+    """A drop area (a click on it opens the file chooser) for one design file (.json) of at most
+    :data:`core.io.design_file.MAX_DESIGN_BYTES`."""
+    return pn.widgets.FileDropper(
+        accepted_filetypes=[".json", "application/json"], max_file_size=f"{MAX_DESIGN_BYTES // 1000}KB",
+        chunk_size=CHUNK_BYTES, multiple=False, previews=[], layout="compact", sizing_mode="stretch_width",
+        height=70,
     )
 
 

@@ -9,8 +9,9 @@ import panel as pn
 import pytest
 from bokeh.document import Document
 
-from app.link import URL_NAMES
+from app.link import URL_NAMES, design_query
 from app.main import URL_DELAY_MS, App
+from core import PAPER_B
 
 
 @pytest.fixture
@@ -48,7 +49,9 @@ def test_a_link_with_bad_values_applies_the_good_ones_and_says_which(session):
     s = app.state
     assert (s.mode, s.outer_radius_mm, s.frequency_hz, s.tolerance_text, s.band_on) == ("radial", 40, 20, "mu:10", True)
     assert s.amplitude > 0 and s.shear_modulus_mpa == 2.42  # kept: the link's values are no values
-    assert "-5.0 was not usable" in s.errors["amplitude"] and "'abc' was not usable" in s.errors["shear_modulus_mpa"]
+    # each refused value's message names the key, the value, the rule and what is kept
+    assert s.errors["amplitude"].startswith("The link's amp=-5.0 is outside this bushing's amplitude axis (")
+    assert s.errors["shear_modulus_mpa"] == "The link's mu_MPa='abc' is not a number; kept 2.42."
     flush(session)
     assert set(url()) == set(URL_NAMES.values())  # the whole session is in the address bar
     assert (url()["b_mm"], url()["f_Hz"], url()["tol"], url()["bands"]) == ("40", "20", "mu:10", "true")
@@ -75,12 +78,72 @@ def test_quick_changes_write_the_url_once_and_nothing_echoes(session):
     assert len(writes) == 2 and pn.state.location.search == before  # the back button's own; none after it
 
 
-def test_a_blank_field_travels_in_the_link_as_blank(session):
+def test_a_field_the_rules_refuse_is_never_written_to_the_link(session):
+    """The address bar shows what the plots draw: a blank or invalid field keeps its message
+    beside it, the link the value drawn (the field is not reset by the link's own write)."""
     app = opened("")
     app.state.outer_radius_mm = None  # the field emptied
+    app.state.shear_modulus_mpa = -1.0
     flush(session)
-    link = pn.state.location.search
-    assert url()["b_mm"] == "null"  # the link's format, as before
-    pn.state.curdoc = Document()  # a new session at that link: the field is blank again, said so
-    again = opened(link)
+    assert (url()["b_mm"], url()["mu_MPa"]) == ("35", "2.42")  # the drawn design's
+    assert app.state.outer_radius_mm is None and set(app.state.errors) == {"outer_radius_mm", "shear_modulus_mpa"}
+    pn.state.curdoc = Document()  # a link with a blank value still opens blank, said so
+    again = opened("?b_mm=null")
     assert again.state.outer_radius_mm is None and again.state.errors == {"outer_radius_mm": "Enter a number."}
+
+
+def test_a_link_holds_the_effects_the_name_and_the_reference(session):
+    app = opened("")
+    s = app.state
+    s.pin_reference()
+    diagnosed = s.design.replace(name="Paper B (diagnosed)", effects={"viscous": {"viscosity": 1234.5},
+                                                                      "inertia": {"mass": 0.25}})
+    s.adopt(diagnosed)
+    s.length_mm = 80.0  # the reference stays Paper B
+    s.pin_reference()
+    s.length_mm = 90.0  # back to the diagnosed design, named again
+    assert s.design == diagnosed
+    flush(session)
+    assert url()["effects"] == "inertia@axial.mass:0.25,viscous.viscosity:1234.5"
+    assert (url()["name"], url()["ref.L_mm"], url()["ref.effects"]) == ("Paper B (diagnosed)", "80", url()["effects"])
+    link = pn.state.location.search
+    pn.state.curdoc = Document()
+    again = opened(link).state
+    assert again.design == diagnosed and again.errors == {}
+    ref, want = again.reference.to_dict(), s.reference.to_dict()
+    assert ref["effects"] == want["effects"] and ref["geometry"] == pytest.approx(want["geometry"], rel=1e-12)
+
+
+def test_a_links_bad_effect_or_amplitude_is_refused_with_its_rule(session):
+    reference = "&".join(f"ref.{k}={v}" for k, v in design_query(PAPER_B).items() if k != "name")
+    app = opened("?amp=1e6&effects=viscous.viscosity:-3&" + reference.replace("ref.a_mm=20", "ref.a_mm=50"))
+    s = app.state
+    assert s.amplitude == 0.1 and s.effects == {} and s.reference is None
+    assert s.errors["amplitude"].startswith("The link's amp=1000000.0 is outside this bushing's amplitude axis")
+    assert s.errors["effects"] == ("The link's effects='viscous.viscosity:-3' must be ≥ 0, got -3.0; kept none.")
+    assert s.errors["reference"] == "The link's ref.b_mm='35' must be larger than the inner radius a; kept none."
+    flush(session)
+    assert url()["amp"] == "0.1" and "effects" not in url() and "ref.a_mm" not in url()
+
+
+def test_a_design_file_downloaded_opens_again_exactly(session):
+    """The export's design file, opened in the sidebar, is the design again (name, effects,
+    exact SI values) at the operating point the user had; a broken one is named and refused."""
+    from app.inputs import DesignFile
+    from core.io.design_file import dumps_design, loads_design
+
+    app = opened("?f_Hz=40&amp=0.3")
+    s = app.state
+    s.adopt(s.design.replace(name="Mine", effects={"viscous": {"viscosity": 777.0}, "inertia": {"mass": 0.3}}))
+    saved = app.export._design_json().getvalue()
+    assert loads_design(saved) == s.design
+    shown = s.design
+    s.shear_modulus_mpa = 1.5
+    opener = DesignFile(s)
+    assert opener.load(saved.encode(), "bushing-design.json")
+    assert s.design == shown and (s.amplitude, s.frequency_hz) == (0.3, 40)
+    assert opener.load(b'{"mode": "axial"}', "broken.json") is False
+    assert opener.message.object.startswith('<div class="field-error" style="color:#b03a2e">⚠ broken.json not loaded: ')
+    assert "geometry: missing (required)" in opener.message.object and s.design == shown
+    assert opener.load(dumps_design(PAPER_B.in_mode("torsion")), "t.json")  # another mode: mid-range amplitude
+    assert s.design.mode == "torsion" and s.errors == {}

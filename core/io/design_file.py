@@ -21,6 +21,7 @@ from ..rules import (
     UNKNOWN_KEY,
     DesignError,
     Words,
+    decoded,
     read_text,
     strict_json,
 )
@@ -140,6 +141,13 @@ def read_design_file(path: str | Path) -> tuple[Design, dict | None]:
         return loads_design_file(text)
     except DesignError as exc:
         raise DesignError(exc.key, f"{exc.rule} (in {path.name})", exc.code) from None
+
+
+def loads_design_upload(content: bytes | str) -> tuple[Design, dict | None]:
+    """:func:`read_design_file` for a file's content already read (an upload): at most
+    :data:`MAX_DESIGN_BYTES` bytes of UTF-8 (a byte-order mark dropped), then
+    :func:`loads_design_file`'s rules; the design and its ``fit`` object, if any."""
+    return loads_design_file(decoded(content, MAX_DESIGN_BYTES, _WORDS, DesignError))
 
 
 def dumps_design(design: Design) -> str:

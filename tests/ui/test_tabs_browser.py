@@ -56,7 +56,7 @@ def test_upload_fit_and_use(page, explorer_url, tmp_path):
     open_explorer(page, explorer_url)
     page.get_by_text("Measured data and fit", exact=True).click()
     page.get_by_role("button", name="Fit the five material parameters").wait_for()
-    inputs = page.locator("input[type=file]")
+    inputs = page.locator("#main input[type=file]")  # the tab's drop areas (the sidebar opens design files)
     inputs.first.set_input_files(str(bad))
     expect(page.locator(".data-error")).to_contain_text("line 2: magnitude is missing")
     inputs.first.set_input_files(str(good))  # the drop area holds both: the good one loads
@@ -90,7 +90,7 @@ def test_an_oversized_file_is_refused_in_the_browser(page, explorer_url, tmp_pat
     open_explorer(page, explorer_url)
     page.get_by_text("Measured data and fit", exact=True).click()
     page.get_by_role("button", name="Fit the five material parameters").wait_for()
-    inputs = page.locator("input[type=file]")
+    inputs = page.locator("#main input[type=file]")  # the tab's drop areas (the sidebar opens design files)
     inputs.first.set_input_files(str(big))
     page.get_by_text("File is too large").first.wait_for()
     assert page.get_by_text("Maximum file size is 20 MB").count() >= 1
