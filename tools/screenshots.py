@@ -7,8 +7,8 @@
 Without ``--url`` it starts ``bushing serve --port 0`` from this repository (the port the OS
 picks, read from the line the server prints) and stops it at the end. For each size it opens the
 page in a window of that size, selects each tab in turn (through the tab bar's model, so a tab
-whose header is off screen is still shot), waits until every figure shown holds data and every
-view has painted, and writes ``<out>/<width>x<height>/<nn>-<tab>.png`` (the window, not the
+whose header is off screen is still shot), waits until every figure shown and every view has
+painted, and writes ``<out>/<width>x<height>/<nn>-<tab>.png`` (the window, not the
 whole page: what a user of that screen sees). The README's screenshots are made with it.
 """
 
@@ -38,8 +38,8 @@ SELECT_JS = """(index) => {
   tabs.active = index;
 }"""
 
-# the document idle, the selected tab's content laid out, and every figure shown (a figure view
-# with a size on the page) holding data
+# the document idle, the selected tab's content sent (not Panel's placeholder) and laid out, and
+# every figure shown (a figure view with a size on the page) painted
 DRAWN_JS = """() => {
   if (!(window.Bokeh && Bokeh.documents.length > 0 && Bokeh.documents[0].is_idle)) return false;
   const views = [...Bokeh.index.all_views()];
@@ -47,11 +47,9 @@ DRAWN_JS = """() => {
   if (!tabs) return false;
   const child = tabs.child_views[tabs.model.active];
   if (!child || child.model.type === 'Spacer') return false;  // Panel's placeholder of a tab not yet sent
-  if (child.el.getBoundingClientRect().height < 150) return false;  // a lazy tab: built
+  if (child.el.getBoundingClientRect().height < 150) return false;  // a lazy tab: not yet filled
   const shown = v => { const r = v.el.getBoundingClientRect(); return r.width > 0 && r.height > 0; };
-  const points = m => m.renderers.some(r => r.data_source && r.data_source.data &&
-      Object.values(r.data_source.data).some(c => c && c.length > 0));
-  return views.filter(v => v.model.type === 'Figure' && shown(v)).every(v => points(v.model));
+  return views.filter(v => v.model.type === 'Figure' && shown(v)).every(v => v.has_finished());
 }"""
 
 SETTLE_JS = """() => Promise.all([...Bokeh.index.all_views()].map(v => v.ready))"""
@@ -106,7 +104,7 @@ def shoot(url: str, out: Path, sizes, chromium: str) -> list[Path]:
                 try:
                     page.wait_for_function(DRAWN_JS, timeout=DRAW_TIMEOUT_MS if index else LOAD_TIMEOUT_MS)
                 except Exception:  # noqa: BLE001 - a tab still drawing is shot as it is, said
-                    print(f"screenshots: {title!r} at {width}x{height} : a figure shown holds no data (shot as it is)", file=sys.stderr)
+                    print(f"screenshots: {title!r} at {width}x{height} was not drawn in time (shot as it is)", file=sys.stderr)
                 page.evaluate(SETTLE_JS)
                 path = folder / f"{index + 1:02d}-{slug(title)}.png"
                 page.screenshot(path=str(path))

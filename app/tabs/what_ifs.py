@@ -67,13 +67,15 @@ class WhatIfView(PlotView):
         for name, widget in self.tolerance_inputs.items():
             widget.param.watch(lambda e, n=name: self._set_tolerance(n, e.new), "value")
         s = state.param
-        self.band_controls = pn.Row(
+        # FlexBox, not Row: the controls wrap onto a second line in a narrow window (a Row ran
+        # past the window's edge at 1280 px and cut the last checkbox's label)
+        self.band_controls = pn.FlexBox(
             pn.widgets.Checkbox.from_param(s.band_on, margin=(28, 10), width=330, css_classes=["band-switch"]),
             pn.widgets.Select.from_param(s.band_distribution, width=120),
             IntInput.from_param(s.band_samples, width=100),
             IntInput.from_param(s.band_seed, width=100),
             pn.widgets.Checkbox.from_param(s.band_from_fit, margin=(28, 10)),
-            sizing_mode="stretch_width")
+            align_items="flex-start", sizing_mode="stretch_width")
         self.band_status = pn.pane.HTML("", sizing_mode="stretch_width")
         self.sentence = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.bars: LivePlot | None = None
@@ -208,13 +210,16 @@ class WhatIfView(PlotView):
         w = FloatInput.from_param
         tol_grid = pn.GridBox(*self.tolerance_inputs.values(), ncols=4, sizing_mode="stretch_width")
         form = pn.Column(
-            pn.Row(w(self.form.param.target_magnitude, width=150), w(self.form.param.target_tolerance_pct, width=120),
-                   w(self.form.param.loss_factor_min, width=150), w(self.form.param.ratio_min, width=150)),
-            pn.Row(w(self.form.param.b_max_mm, width=150), w(self.form.param.length_max_mm, width=150),
-                   w(self.form.param.thickness_min_mm, width=170),
-                   pn.widgets.Checkbox.from_param(self.form.param.hold_inner, margin=(28, 10))),
-            pn.Row(w(self.form.param.mu_min_mpa, width=150), w(self.form.param.mu_max_mpa, width=150),
-                   pn.pane.HTML("<i>A µ range lets the compound vary too.</i>", margin=(28, 10))),
+            pn.FlexBox(w(self.form.param.target_magnitude, width=150), w(self.form.param.target_tolerance_pct, width=120),
+                       w(self.form.param.loss_factor_min, width=150), w(self.form.param.ratio_min, width=150),
+                       sizing_mode="stretch_width"),
+            pn.FlexBox(w(self.form.param.b_max_mm, width=150), w(self.form.param.length_max_mm, width=150),
+                       w(self.form.param.thickness_min_mm, width=170),
+                       pn.widgets.Checkbox.from_param(self.form.param.hold_inner, margin=(28, 10)),
+                       sizing_mode="stretch_width"),
+            pn.FlexBox(w(self.form.param.mu_min_mpa, width=150), w(self.form.param.mu_max_mpa, width=150),
+                       pn.pane.HTML("<i>A µ range lets the compound vary too.</i>", margin=(28, 10)),
+                       sizing_mode="stretch_width"),
             pn.Row(self.find, self.targets_file),
             self.result, pn.Row(self.solutions, self.use), sizing_mode="stretch_width")
         return pn.Column(
