@@ -14,9 +14,9 @@ from core.whatif.sensitivity import elasticities, ranked, sentence
 from core.whatif.tolerance import ToleranceError
 
 from .. import curves, units
-from ..bands import band_tolerances, banded
+from ..bands import band_tolerances, banded, tolerance_refusal
 from ..fit_state import FitState
-from ..inputs import FloatInput, IntInput
+from ..inputs import FIELD_ERROR_STYLES, FloatInput, IntInput, field_error_html
 from ..live import LivePlot
 from ..plotting.what_ifs import sensitivity_bars
 from ..state import ExplorerState
@@ -66,6 +66,9 @@ class WhatIfView(PlotView):
             for n in NAMES}
         for name, widget in self.tolerance_inputs.items():
             widget.param.watch(lambda e, n=name: self._set_tolerance(n, e.new), "value")
+        # beside each tolerance: why the design cannot take it (app.bands.tolerance_refusal)
+        self.tolerance_errors = {n: pn.pane.HTML("", margin=(0, 10, 4, 10), styles=FIELD_ERROR_STYLES,
+                                                 sizing_mode="stretch_width") for n in NAMES}
         s = state.param
         # FlexBox, not Row: the controls wrap onto a second line in a narrow window (a Row ran
         # past the window's edge at 1280 px and cut the last checkbox's label)
@@ -122,6 +125,9 @@ class WhatIfView(PlotView):
         explorer's and the card's bands, cached, say why a band cannot be computed)."""
         s = self.state
         fit = self.fit.fit_result
+        refused, message = tolerance_refusal(self._shown_tolerances(), s.design)
+        for name, pane in self.tolerance_errors.items():
+            pane.object = field_error_html(f"tolerance:{name}", message if name in refused else "")
         tolerances = band_tolerances(**s.band_inputs(), fit_result=fit)
         design, f, x = s.design, s.frequency_hz, s.amplitude
         _, reason = banded(tolerances, lambda tol: curves.operating_bands(design, f, x, s.freq_range, tol))
@@ -131,6 +137,8 @@ class WhatIfView(PlotView):
             except ValueError:  # no card for this design: its tab says so
                 pass
         if s.band_on and reason:
+            if refused and reason == message:  # said beside the field
+                reason = "a tolerance the design cannot take (said beside it, above)"
             self.band_status.object = f'<span style="color:#8a5300">No band: {reason}</span>'
         elif s.band_on:
             self.band_status.object = "Bands are drawn on the Explorer's stiffness plots and in Every direction."
@@ -208,7 +216,8 @@ class WhatIfView(PlotView):
 
     def __panel__(self):
         w = FloatInput.from_param
-        tol_grid = pn.GridBox(*self.tolerance_inputs.values(), ncols=4, sizing_mode="stretch_width")
+        tol_grid = pn.GridBox(*(pn.Column(widget, self.tolerance_errors[n], margin=0, sizing_mode="stretch_width")
+                                for n, widget in self.tolerance_inputs.items()), ncols=4, sizing_mode="stretch_width")
         form = pn.Column(
             pn.FlexBox(w(self.form.param.target_magnitude, width=150), w(self.form.param.target_tolerance_pct, width=120),
                        w(self.form.param.loss_factor_min, width=150), w(self.form.param.ratio_min, width=150),
