@@ -176,7 +176,7 @@ def _refusal_words(exc: ToleranceError, relative: dict[str, float], design: Desi
     g = design.geometry
     a, b = g.inner_radius, g.outer_radius
     if exc.code == OUTER_NOT_LARGER:
-        named = tuple(n for n in ("inner_radius", "outer_radius") if n in relative)
+        named = tuple(n for n in GEOMETRY if n in relative and n != "length")  # the radii
         given = " and ".join(f"{BY_NAME[n].symbol} ± {100 * relative[n]:g} %" for n in named)
         moves = []
         if "inner_radius" in relative:
