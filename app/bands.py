@@ -10,8 +10,10 @@ import math
 
 import param
 
-from core.parameters import MATERIAL, PARAMETERS
-from core.rules import RuleError, decimal
+from core import Design
+from core.parameters import BY_NAME, DEFAULT_SHAPE, GEOMETRY, MATERIAL, PARAMETERS
+from core.rules import OUTER_NOT_LARGER, RuleError, decimal
+from core.shape import OutsideTable, table
 from core.whatif.tolerance import SAMPLES, FitCovariance, ToleranceError, Tolerances
 
 # a parameter's key in the tolerances of a link (tol=mu:10,L:1)
@@ -66,8 +68,9 @@ class ToleranceBands(param.Parameterized):
         self.tolerance_text = ",".join(f"{TOLERANCE_KEYS[n]}:{v:g}" for n, v in values.items() if v)
 
     def band_inputs(self) -> dict:
-        """The band inputs' values, by the names of :func:`band_tolerances`' arguments."""
-        return {name: getattr(self, name) for name in BAND_INPUTS}
+        """The band inputs' values and the design they vary, by the names of
+        :func:`band_tolerances`' arguments."""
+        return {**{name: getattr(self, name) for name in BAND_INPUTS}, "design": getattr(self, "design", None)}
 
 
 # the band inputs (parameters of ToleranceBands); a band also depends on the fit (fit_result of
@@ -76,13 +79,22 @@ BAND_INPUTS = tuple(n for n in ToleranceBands.param if n != "name")
 
 
 def band_tolerances(tolerance_text: str, band_on: bool, band_distribution: str, band_samples: int,
-                    band_seed: int, band_from_fit: bool, fit_result=None) -> Tolerances | str | None:
+                    band_seed: int, band_from_fit: bool, fit_result=None,
+                    design: Design | None = None) -> Tolerances | str | None:
     """The tolerances the bands are drawn with (:class:`core.whatif.tolerance.Tolerances`), from
     the band inputs' values (:class:`ToleranceBands`) and the last fit (a
     :class:`core.identify.fit.FitResult` or None, for ``band_from_fit``); None when the bands are
-    off; else the reason why there is no band (a str). Pure."""
+    off; else the reason why there is no band (a str: for tolerances ``design`` cannot take,
+    :func:`tolerance_refusal`'s). Pure."""
     if not band_on:
         return None
+    if design is not None:
+        try:
+            refused = tolerance_refusal(parse_tolerances(tolerance_text), design)[1]
+        except ToleranceError as exc:
+            return str(exc)
+        if refused:
+            return refused
     try:
         material = set(MATERIAL) if band_from_fit else set()
         relative = {n: v / 100.0 for n, v in parse_tolerances(tolerance_text).items() if v and n not in material}
@@ -134,3 +146,86 @@ def tolerances_of(key: tuple) -> Tolerances:
         errors, correlation = covariance
         covariance = FitCovariance(dict(errors), {a: dict(row) for a, row in correlation})
     return Tolerances(dict(relative), dict(absolute), distribution, samples, seed, percentiles, covariance)
+
+
+# ---- a refusal in the panel's words ---------------------------------------------------------
+
+
+def _shown(name: str, value: float) -> str:
+    """``value`` (SI) of parameter ``name`` in its display unit: ``17.5 mm``."""
+    unit = BY_NAME[name].unit
+    return f"{unit.to_display(value):.4g} {unit.display}".rstrip()
+
+
+def tolerance_refusal(tolerance_pct: dict[str, float], design: Design) -> tuple[tuple[str, ...], str]:
+    """The parameters (core names) whose tolerances (± %, by name) ``design`` cannot take, and
+    why, in the panel's words and display units; ``((), "")`` when it can take them. The core
+    judges (:meth:`core.whatif.tolerance.Tolerances.check`); a message names only parameters
+    given a tolerance, and says how far the tolerance may go. A geometry whose samples would
+    leave the finite-length table (a corner of the tolerance box outside it) is refused too."""
+    relative = {n: v / 100.0 for n, v in tolerance_pct.items() if v}
+    tol = Tolerances(relative)
+    try:
+        tol.check(design)
+    except ToleranceError as exc:
+        return _refusal_words(exc, relative, design)
+    return _outside_table(relative, design)
+
+
+def _refusal_words(exc: ToleranceError, relative: dict[str, float], design: Design) -> tuple[tuple[str, ...], str]:
+    g = design.geometry
+    a, b = g.inner_radius, g.outer_radius
+    if exc.code == OUTER_NOT_LARGER:
+        named = tuple(n for n in GEOMETRY if n in relative and n != "length")  # the radii
+        given = " and ".join(f"{BY_NAME[n].symbol} ± {100 * relative[n]:g} %" for n in named)
+        moves = []
+        if "inner_radius" in relative:
+            moves.append(f"a reach {_shown('inner_radius', a * (1 + relative['inner_radius']))}")
+        if "outer_radius" in relative:
+            moves.append(f"b fall to {_shown('outer_radius', b * (1 - relative['outer_radius']))}")
+        if len(named) == 1:
+            (name,) = named
+            other = "outer_radius" if name == "inner_radius" else "inner_radius"
+            bound = (f"with {BY_NAME[other].symbol} = {_shown(other, design.value(other))}, the tolerance of "
+                     f"{BY_NAME[name].symbol} must stay below {100 * (b - a) / design.value(name):.3g} %")
+        else:
+            bound = f"the two half-widths together must stay below b − a = {_shown('length', b - a)}"
+        lets = "lets" if len(named) == 1 else "let"
+        return named, f"{given} {lets} {' and '.join(moves)}: some bushings would have no rubber (b ≤ a); {bound}."
+    name = exc.key.removeprefix("tolerances.")
+    if name in BY_NAME and name in relative:
+        low, high = (design.value(name) * (1 + s * relative[name]) for s in (-1, 1))
+        return (name,), (f"{BY_NAME[name].label} ± {100 * relative[name]:g} % spans {_shown(name, low)} to "
+                         f"{_shown(name, high)}, outside what the model takes ({exc.rule}).")
+    return (), str(exc)
+
+
+def _outside_table(relative: dict[str, float], design: Design) -> tuple[tuple[str, ...], str]:
+    """The geometry tolerances whose box leaves the finite-length table, and the ratios' ranges."""
+    named = tuple(n for n in GEOMETRY if n in relative)
+    if not named or design.shape != "finite":
+        return (), ""
+    g = design.geometry
+    corners = [dict(zip(GEOMETRY, (g.inner_radius * (1 + i * relative.get("inner_radius", 0.0)),
+                                   g.outer_radius * (1 + j * relative.get("outer_radius", 0.0)),
+                                   g.length * (1 + k * relative.get("length", 0.0)))))
+               for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)]
+    outside = False
+    for corner in corners:
+        try:
+            _ = design.replace(**corner).shape_factor  # raises outside the table
+        except OutsideTable:
+            outside = True
+            break
+    if not outside:
+        return (), ""
+    t = table()
+    radius = [c["outer_radius"] / c["inner_radius"] for c in corners]
+    length = [c["length"] / (c["outer_radius"] - c["inner_radius"]) for c in corners]
+    given = ", ".join(f"{BY_NAME[n].symbol} ± {100 * relative[n]:g} %" for n in named)
+    way_out = (" (or switch off the finite-length shape factor: the long-bushing formula)"
+               if DEFAULT_SHAPE[design.mode] != "finite" else "")
+    return named, (f"With {given}, b/a spans {min(radius):.3g}–{max(radius):.3g} and L/(b − a) "
+                   f"{min(length):.3g}–{max(length):.3g}; the finite-length table covers b/a "
+                   f"{t.radius_ratio[0]:g}–{t.radius_ratio[-1]:g} and L/(b − a) {t.length_ratio[0]:g}–"
+                   f"{t.length_ratio[-1]:g}: narrow the tolerance{way_out}.")

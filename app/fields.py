@@ -8,15 +8,16 @@ wrong with each field in the words of the input panel. No Panel import.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 
 import param
 
 from core import PAPER_B, Design, DesignError, Geometry, Material
 from core.bushing import factors
-from core.parameters import BY_NAME, GEOMETRY, MATERIAL, PARAMETERS, DesignParameter
+from core.parameters import BY_NAME, DEFAULT_SHAPE, GEOMETRY, MATERIAL, PARAMETERS, DesignParameter
 from core.parts import SIZE_RANGE, as_dict
 from core.rules import NOT_POSITIVE, ORDER_RANGE, OUTER_NOT_LARGER
+from core.shape import OutsideTable, table
 
 # field name → its design parameter, in the table's order (geometry, then material)
 DESIGN_FIELDS: dict[str, DesignParameter] = {p.field: p for p in PARAMETERS}
@@ -45,11 +46,13 @@ DesignFields = type("DesignFields", (param.Parameterized,), {
 
 
 def design_from_fields(fields: Mapping, shown: Design, mode: str, shape: str | None,
-                       effects) -> tuple[Design | None, dict[str, str]]:
+                       effects, edited: Iterable[str] = ()) -> tuple[Design | None, dict[str, str]]:
     """The design that ``fields`` (field name → value in display units) give in ``mode`` with
     ``shape`` and ``effects``, and ``{}``; or None and, field by field, what is wrong. The core's
     rules judge: a field alone against the values of ``shown`` (the design shown last), b > a
-    whatever else is wrong, then the whole design (its shape factor must exist)."""
+    whatever else is wrong, then the whole design (its shape factor must exist: a geometry
+    outside the finite-length table is said beside the geometry field just ``edited``, else
+    beside the fields whose ratio is outside, by :func:`outside_table`)."""
     errors: dict[str, str] = {}
     values: dict[str, float] = {}
     for name, p in DESIGN_FIELDS.items():
@@ -79,9 +82,44 @@ def design_from_fields(fields: Mapping, shown: Design, mode: str, shape: str | N
         factors(design)  # the shape factor exists for this geometry (the FE table's range)
     except DesignError as exc:
         return None, {ERROR_FIELD.get(exc.key, "mode"): _plain(exc)}
-    except ValueError as exc:  # outside the finite-length table: a geometry to change
-        return None, {_LENGTH: f"{exc}."}
+    except OutsideTable:  # a geometry to change
+        message, involved = outside_table(geometry, mode)
+        edited_geometry = [n for n in GEOMETRY_FIELDS if n in edited]
+        return None, dict.fromkeys(edited_geometry or involved, message)
     return design, {}
+
+
+def outside_table(geometry: Geometry, mode: str) -> tuple[str, tuple[str, ...]]:
+    """Why ``geometry`` has no finite-length shape factor, in the panel's words and display
+    units: the table's limits, this bushing's ratios, the range each field may take with the
+    others as they are, and (where ``mode`` has one) the long-bushing formula as the other way
+    out; and the fields whose ratio is outside the table."""
+    t = table()
+    (lo_r, hi_r), (lo_l, hi_l) = t.radius_ratio[[0, -1]], t.length_ratio[[0, -1]]
+    a, b, L = geometry.inner_radius, geometry.outer_radius, geometry.length
+    mm = {n: BY_NAME[n].unit for n in GEOMETRY}
+
+    def span(name: str, low: float, high: float) -> str:
+        unit = mm[name]
+        return f"{unit.to_display(low):.3g}–{unit.to_display(high):.3g} {unit.display}"
+
+    def value(name: str, v: float) -> str:
+        return f"{BY_NAME[name].symbol} = {mm[name].to_display(v):.3g} {mm[name].display}"
+
+    parts, involved = [], []
+    if not lo_r <= b / a <= hi_r:
+        parts.append(f"b/a is {b / a:.3g}, the table covers {lo_r:g}–{hi_r:g}: with {value('inner_radius', a)}, "
+                     f"b may be {span('outer_radius', lo_r * a, hi_r * a)}")
+        involved += [_INNER, _OUTER]
+    if not lo_l <= L / (b - a) <= hi_l:
+        parts.append(f"L/(b − a) is {L / (b - a):.3g}, the table covers {lo_l:g}–{hi_l:g}: with b − a = "
+                     f"{mm['length'].to_display(b - a):.3g} {mm['length'].display}, L may be "
+                     f"{span('length', lo_l * (b - a), hi_l * (b - a))}")
+        involved += [_INNER, _OUTER, _LENGTH]
+    way_out = (" Or switch off the finite-length shape factor (the long-bushing formula)."
+               if DEFAULT_SHAPE[mode] != "finite" else "")
+    message = "Outside the finite-length table: " + "; ".join(parts) + "." + way_out
+    return message, tuple(dict.fromkeys(involved)) or (_LENGTH,)
 
 
 # what the input panel says for a rule, by the rule's code (core.rules): the panel's own words

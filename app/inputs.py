@@ -105,15 +105,23 @@ class LogSlider(pn.viewable.Viewer):
         return pn.Row(self.slider, self.help, sizing_mode="stretch_width")
 
 
+# the look of a message beside a field (every tab's)
+FIELD_ERROR_STYLES = {"color": "#b03a2e", "font-size": "0.9em"}
+
+
+def field_error_html(name: str, message: str) -> str:
+    """The message beside field ``name`` (HTML), or nothing for no message."""
+    return f'<div class="field-error" data-field="{name}">⚠ {message}</div>' if message else ""
+
+
 def error_text(state: ExplorerState, name: str):
     """The message beside a widget: what is wrong with its value, or nothing."""
 
     def render(errors):
-        msg = errors.get(name)
-        return f'<div class="field-error" data-field="{name}">⚠ {msg}</div>' if msg else ""
+        return field_error_html(name, errors.get(name, ""))
 
     return pn.pane.HTML(pn.bind(render, state.param.errors), margin=(0, 10, 4, 10),
-                        styles={"color": "#b03a2e", "font-size": "0.9em"}, sizing_mode="stretch_width")
+                        styles=FIELD_ERROR_STYLES, sizing_mode="stretch_width")
 
 
 class DesignInputs(pn.viewable.Viewer):

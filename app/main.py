@@ -30,6 +30,12 @@ pn.extension("filedropper", throttled=False)  # the upload areas (app.uploads) a
 
 TITLE = "Bushing Explorer"
 
+# the tab bar wraps onto a second row when its headers do not fit the width (Bokeh's own bar
+# hides the headers past its right edge: at 1280 px two tabs were unreachable)
+TAB_BAR_CSS = """
+.bk-headers-wrapper { flex-wrap: wrap; row-gap: 2px; }
+"""
+
 # uploads travel in chunks of app.uploads.CHUNK_BYTES (base64 in JSON: 4/3 of it); no other
 # message comes near this
 UPLOAD_MESSAGE_BYTES = 16 * 1024 * 1024
@@ -78,6 +84,7 @@ class App(pn.viewable.Viewer):
             ("About", pn.pane.Markdown(ABOUT, sizing_mode="stretch_width")),
             dynamic=True,
             sizing_mode="stretch_width",
+            stylesheets=[TAB_BAR_CSS],
         )
         self.tabs.param.watch(self._on_tab, "active")
         self._on_tab()

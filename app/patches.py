@@ -95,7 +95,7 @@ def install(doc=None) -> None:
     """Put the hooks of this module in place, each once however often it is called: the MathJax
     decision and the number edits without debounce (process-wide), and the BokehJS paint patches
     in the page of ``doc`` (if given, unless ``BUSHING_BOKEHJS_PATCHES=0``), and
-    :data:`BOKEHJS_SERVER_MODELS` in it (if given)."""
+    :data:`BOKEHJS_SERVER_MODELS` and :data:`LABEL_CLICKS` in it (if given)."""
     global _installed
     if not _installed:
         if hasattr(panel_resources, "_panel_use_mathjax"):
@@ -111,6 +111,7 @@ def install(doc=None) -> None:
         from bokeh.models import CustomJS
 
         doc.js_on_event("document_ready", CustomJS(code=BOKEHJS_SERVER_MODELS))
+        doc.js_on_event("document_ready", CustomJS(code=LABEL_CLICKS))
         _pages.add(doc)
 
 
@@ -252,6 +253,25 @@ if (window.bushingServerModels == null) {
   } else {
     window.bushingServerModels = "unpatched"
   }
+}
+"""
+
+
+# A checkbox's or a switch's label toggles it (issue #27): BokehJS 3.9 draws the label as a <div>
+# beside the box (a Checkbox's <input>, a Switch's .bk-body) in the widget's shadow root, not as a
+# <label>, so a click on the words did nothing. One listener on the page: a click whose path (through
+# open shadow roots) holds such a label and not the box itself clicks the box of the same root.
+LABEL_CLICKS = """
+if (!window.bushingLabelClicks) {
+  window.bushingLabelClicks = true;
+  document.addEventListener('click', (event) => {
+    const path = event.composedPath();
+    const label = path.find(el => el instanceof Element && el.classList.contains('bk-label'));
+    if (!label || !(label.parentNode instanceof ShadowRoot)) return;
+    const root = label.parentNode;
+    const box = [...root.children].find(el => el.matches('input[type=checkbox], .bk-body'));
+    if (box && !path.includes(box) && !box.disabled && !root.host.classList.contains('bk-disabled')) box.click();
+  });
 }
 """
 

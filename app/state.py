@@ -125,7 +125,7 @@ class ExplorerState(DesignFields, ToleranceBands):
             return
         shape = "finite" if self.finite_length else None
         fields = {name: getattr(self, name) for name in DESIGN_FIELDS}
-        design, errors = design_from_fields(fields, self.design, self.mode, shape, self.effects)
+        design, errors = design_from_fields(fields, self.design, self.mode, shape, self.effects, edited=names)
         design = self.design if design is None else _match_shown(design, [*PRESETS.values(), *self._loaded])
         errors.update(frequency_errors(self.freq_min, self.freq_max))
         values = {"freq_range": (1.0, 100.0) if {"freq_min", "freq_max"} & set(errors)

@@ -64,8 +64,13 @@ def test_tolerances_that_cannot_be_used_say_why_and_keep_the_plots(app):
     assert "No tolerance band" in app.plots.summary.object and "no rubber" in app.plots.summary.object
     assert all(e.label != "5–95 % band" for e in app.plots.frame(("magnitude", "frequency")))
     app.tabs.active = WHAT_IFS
-    assert "No band" in v.band_status.object and "no rubber" in v.band_status.object
+    assert "No band" in v.band_status.object
+    # the why beside the field that caused it, in mm, naming only b (a has no tolerance)
+    said = v.tolerance_errors["outer_radius"].object
+    assert "no rubber" in said and "17.5 mm" in said and "a reach" not in said
+    assert all(not v.tolerance_errors[n].object for n in v.tolerance_errors if n != "outer_radius")
     v.tolerance_inputs["outer_radius"].value = 0
+    assert not v.tolerance_errors["outer_radius"].object
     app.state.band_from_fit = True  # no fit yet
     assert "no fit yet" in v.band_status.object.lower()
     app.tabs.active = 0
@@ -226,7 +231,7 @@ def test_computing_the_bands_writes_nothing_to_the_state(app):
     app.tabs.active = 0
     assert "No tolerance band" in app.plots.summary.object and "no rubber" in app.plots.summary.object
     app.tabs.active = WHAT_IFS
-    assert "No band" in v.band_status.object and "no rubber" in v.band_status.object
+    assert "No band" in v.band_status.object and "no rubber" in v.tolerance_errors["outer_radius"].object
     app.tabs.active = [t for t, *_ in App.LAZY_TABS].index("Every direction") + 1
     assert "magnitude_p5" not in app.export.stiffness_table(n_freq=5, n_amp=4)
     assert [e.name for e in events] == []

@@ -26,7 +26,8 @@ OTHER_PARTS = {
     "benchmarks/": "speed and memory scripts (they print figures and ratios; no assertions)",
     "examples/": "synthetic example data (made from the model, with stated noise), the script that "
                  "makes them and a notebook of the plotting API",
-    "tools/": "maintenance scripts: the finite-length shape-factor table, this section",
+    "tools/": "maintenance scripts: the finite-length shape-factor table, this section, the screenshots "
+              "of every tab (`tools/screenshots.py --out DIR --sizes 1280x720,1600x1000`)",
     "deploy/": "the nginx configuration template for several server processes behind one address",
     "Dockerfile": "the explorer as a container",
     "pyproject.toml": "the package, its dependencies and the `bushing` command",

@@ -31,7 +31,7 @@ def residual_overlays(points: dict | None, residuals: dict | None, dims: dict) -
         for quantity, ydim, column in (("magnitude", dims["residual_magnitude"], "magnitude_residual_pct"),
                                        ("loss", dims["residual_loss"], "loss_factor_residual")):
             y = [] if residuals is None else residuals[column]
-            title = f"{ydim.label}, model − measured, against {against}"
+            title = f"{ydim.label} against {against}"  # (model − measured: the tab's text says)
             out[(quantity, against)] = overlay(
                 [scatter(x, y, dims[against], ydim, "residual", color=OPERATING_COLOR, alpha=0.7, size=6)],
                 title, f"bushing-residual-{quantity}-vs-{against}", logx=against == "amplitude", legend=None,

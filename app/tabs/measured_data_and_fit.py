@@ -200,7 +200,7 @@ class MeasuredView(PlotView):
                 "Load measured dynamic stiffness (and, if you have one, a quasi-static loop) as CSV "
                 "files (drop a file on its area or browse for it, up to 20 MB; the formats are in the About tab), or the "
                 "synthetic example. The points appear over the model in the Explorer tab; the "
-                f"residuals are below. **Fit** identifies {FITTED} with standard "
+                f"residuals (model − measured) are below. **Fit** identifies {FITTED} with standard "
                 "errors and 95 % intervals, and says which parameters the data cannot determine; "
                 "then take the fitted design into the explorer or save it.",
                 sizing_mode="stretch_width"),

@@ -14,9 +14,9 @@ from core.whatif.sensitivity import elasticities, ranked, sentence
 from core.whatif.tolerance import ToleranceError
 
 from .. import curves, units
-from ..bands import band_tolerances, banded
+from ..bands import band_tolerances, banded, tolerance_refusal
 from ..fit_state import FitState
-from ..inputs import FloatInput, IntInput
+from ..inputs import FIELD_ERROR_STYLES, FloatInput, IntInput, field_error_html
 from ..live import LivePlot
 from ..plotting.what_ifs import sensitivity_bars
 from ..state import ExplorerState
@@ -66,14 +66,19 @@ class WhatIfView(PlotView):
             for n in NAMES}
         for name, widget in self.tolerance_inputs.items():
             widget.param.watch(lambda e, n=name: self._set_tolerance(n, e.new), "value")
+        # beside each tolerance: why the design cannot take it (app.bands.tolerance_refusal)
+        self.tolerance_errors = {n: pn.pane.HTML("", margin=(0, 10, 4, 10), styles=FIELD_ERROR_STYLES,
+                                                 sizing_mode="stretch_width") for n in NAMES}
         s = state.param
-        self.band_controls = pn.Row(
+        # FlexBox, not Row: the controls wrap onto a second line in a narrow window (a Row ran
+        # past the window's edge at 1280 px and cut the last checkbox's label)
+        self.band_controls = pn.FlexBox(
             pn.widgets.Checkbox.from_param(s.band_on, margin=(28, 10), width=330, css_classes=["band-switch"]),
             pn.widgets.Select.from_param(s.band_distribution, width=120),
             IntInput.from_param(s.band_samples, width=100),
             IntInput.from_param(s.band_seed, width=100),
             pn.widgets.Checkbox.from_param(s.band_from_fit, margin=(28, 10)),
-            sizing_mode="stretch_width")
+            align_items="flex-start", sizing_mode="stretch_width")
         self.band_status = pn.pane.HTML("", sizing_mode="stretch_width")
         self.sentence = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.bars: LivePlot | None = None
@@ -120,6 +125,9 @@ class WhatIfView(PlotView):
         explorer's and the card's bands, cached, say why a band cannot be computed)."""
         s = self.state
         fit = self.fit.fit_result
+        refused, message = tolerance_refusal(self._shown_tolerances(), s.design)
+        for name, pane in self.tolerance_errors.items():
+            pane.object = field_error_html(f"tolerance:{name}", message if name in refused else "")
         tolerances = band_tolerances(**s.band_inputs(), fit_result=fit)
         design, f, x = s.design, s.frequency_hz, s.amplitude
         _, reason = banded(tolerances, lambda tol: curves.operating_bands(design, f, x, s.freq_range, tol))
@@ -129,6 +137,8 @@ class WhatIfView(PlotView):
             except ValueError:  # no card for this design: its tab says so
                 pass
         if s.band_on and reason:
+            if refused and reason == message:  # said beside the field
+                reason = "a tolerance the design cannot take (said beside it, above)"
             self.band_status.object = f'<span style="color:#8a5300">No band: {reason}</span>'
         elif s.band_on:
             self.band_status.object = "Bands are drawn on the Explorer's stiffness plots and in Every direction."
@@ -206,15 +216,19 @@ class WhatIfView(PlotView):
 
     def __panel__(self):
         w = FloatInput.from_param
-        tol_grid = pn.GridBox(*self.tolerance_inputs.values(), ncols=4, sizing_mode="stretch_width")
+        tol_grid = pn.GridBox(*(pn.Column(widget, self.tolerance_errors[n], margin=0, sizing_mode="stretch_width")
+                                for n, widget in self.tolerance_inputs.items()), ncols=4, sizing_mode="stretch_width")
         form = pn.Column(
-            pn.Row(w(self.form.param.target_magnitude, width=150), w(self.form.param.target_tolerance_pct, width=120),
-                   w(self.form.param.loss_factor_min, width=150), w(self.form.param.ratio_min, width=150)),
-            pn.Row(w(self.form.param.b_max_mm, width=150), w(self.form.param.length_max_mm, width=150),
-                   w(self.form.param.thickness_min_mm, width=170),
-                   pn.widgets.Checkbox.from_param(self.form.param.hold_inner, margin=(28, 10))),
-            pn.Row(w(self.form.param.mu_min_mpa, width=150), w(self.form.param.mu_max_mpa, width=150),
-                   pn.pane.HTML("<i>A µ range lets the compound vary too.</i>", margin=(28, 10))),
+            pn.FlexBox(w(self.form.param.target_magnitude, width=150), w(self.form.param.target_tolerance_pct, width=120),
+                       w(self.form.param.loss_factor_min, width=150), w(self.form.param.ratio_min, width=150),
+                       sizing_mode="stretch_width"),
+            pn.FlexBox(w(self.form.param.b_max_mm, width=150), w(self.form.param.length_max_mm, width=150),
+                       w(self.form.param.thickness_min_mm, width=170),
+                       pn.widgets.Checkbox.from_param(self.form.param.hold_inner, margin=(28, 10)),
+                       sizing_mode="stretch_width"),
+            pn.FlexBox(w(self.form.param.mu_min_mpa, width=150), w(self.form.param.mu_max_mpa, width=150),
+                       pn.pane.HTML("<i>A µ range lets the compound vary too.</i>", margin=(28, 10)),
+                       sizing_mode="stretch_width"),
             pn.Row(self.find, self.targets_file),
             self.result, pn.Row(self.solutions, self.use), sizing_mode="stretch_width")
         return pn.Column(
