@@ -89,17 +89,17 @@ def test_a_page_closed_during_find_designs(page, served_explorer, server_log, bo
     started, closed, computed, ended = (threading.Event() for _ in range(4))
     search, compute = TargetsForm.search, TargetsForm.compute
 
-    def gated(self):
+    def gated(self, progress=None):
         started.set()
         closed.wait(60)  # the search runs on after the page has gone
         try:
-            return compute(self)
+            return compute(self, progress)
         finally:
             computed.set()
 
-    async def watched(self):
+    async def watched(self, doc=None):
         try:
-            await search(self)
+            await search(self, doc)
         finally:
             ended.set()
 
