@@ -14,6 +14,7 @@ from core.identify.diagnose import BIC_THRESHOLD
 from core.material import ConvergenceError
 
 from ..diagnosis_state import DiagnosisState
+from ..inputs import tip
 from ..live import LivePlot, one_change, update_or_keep
 from ..plotting.find_the_missing_effect import diagnosis_overlays
 from ..plotting.style import SWEEP_PALETTES, sweep_label
@@ -52,13 +53,13 @@ class DiagnosisView(pn.viewable.Viewer):
         self.use_measured = pn.widgets.Button(label="Use the data of “Measured data and fit”", color="light")
         self.use_measured.on_click(lambda _e: state.use_measured())
         self.mystery = pn.widgets.Button(label="Load a mystery data set (demo)", color="light",
-                                         description="Synthetic data with an effect hidden in it (or none); "
-                                         "its bushing goes into the explorer. The truth is shown after the diagnosis.")
+                                         description=tip("Synthetic data with an effect hidden in it (or none); "
+                                         "its bushing goes into the explorer. The truth is shown after the diagnosis.", "bottom_center"))
         self.mystery.on_click(lambda _e: state.load_mystery())
         self.baseline = pn.widgets.CheckButtonGroup.from_param(state.param.baseline, color="primary",
                                                                variant="outline")
         self.run = pn.widgets.Button(label="Diagnose", color="primary",
-                                     description="Fit the baseline and every candidate effect; name what is missing.")
+                                     description=tip("Fit the baseline and every candidate effect; name what is missing."))
         self.run.on_click(self._run)
         self.progress = pn.indicators.Progress(value=0, max=100, visible=False, sizing_mode="stretch_width",
                                                bar_color="primary")

@@ -71,12 +71,13 @@ def test_the_diagnosis_shows_its_progress_until_its_report_replaces_it(page, exp
     gone (once: "done…" for 2.2 s before the report)."""
     open_explorer(page, explorer_url)
     upload_150_points(page, tmp_path)
-    watch(page, r"candidate \d+ of \d+[^…]*…", "What is left is noise")
+    watch(page, r"(fitting|trying|candidate \d+ of \d+|profiling|checking|describing)[^…]*…", "What is left is noise")
     page.get_by_role("button", name="Diagnose").click()
     seen = wait_report(page)
-    assert len(seen["progress"]) >= 2, seen["progress"]  # the steps reached the page as they came
-    assert not seen["doneAlone"]
+    assert not seen["doneAlone"], seen["progress"]
     assert not seen["progressWithReport"]
+    assert len(seen["progress"]) >= 2, seen["progress"]  # the steps reached the page as they came
+    assert any(re.search(r"candidate \d+ of \d+: ", p) for p in seen["progress"]), seen["progress"]
     expect(page.locator(".diagnosis-progress")).to_have_count(0)
 
 
@@ -152,9 +153,42 @@ def test_find_designs_shows_where_the_search_is_until_its_result(page, explorer_
     page.get_by_role("button", name="Find designs").click()
     try:
         expect(page.get_by_text("Searching: start 6 of 12…")).to_be_visible(timeout=60_000)
+        assert reached.is_set()  # shown while the search was held there
     finally:
         release.set()
     seen = wait_report(page)
     assert "Searching: start 6 of 12…" in seen["progress"]
     assert not seen["progressWithReport"]
     expect(page.get_by_text(re.compile("Searching: "))).to_have_count(0)
+
+
+# (tab, button, the start of its description)
+DESCRIBED = (
+    ("Measured data and fit", "Fit the five material parameters", "8 starting points"),
+    ("Find the missing effect", "Load a mystery data set (demo)", "Synthetic data with an effect"),
+    ("Find the missing effect", "Diagnose", "Fit the baseline and every candidate"),
+)
+
+
+def overlap(a: dict, b: dict) -> bool:
+    return (a["x"] < b["x"] + b["width"] and b["x"] < a["x"] + a["width"]
+            and a["y"] < b["y"] + b["height"] and b["y"] < a["y"] + a["height"])
+
+
+@pytest.mark.parametrize(("tab", "button", "description"), DESCRIBED)
+def test_a_buttons_description_covers_no_other_button(page, explorer_url, tab, button, description):
+    """The pointer resting on a button shows its description where it hides no other button
+    (once: to its right, over the next button of its row)."""
+    open_explorer(page, explorer_url)
+    page.get_by_text(tab, exact=True).click()
+    hovered = page.get_by_role("button", name=button, exact=True)
+    hovered.wait_for()
+    hovered.scroll_into_view_if_needed()
+    hovered.hover(force=True)  # a disabled button shows its description too
+    shown = page.get_by_text(description).first
+    expect(shown).to_be_visible()
+    box = shown.bounding_box()
+    own = hovered.bounding_box()
+    covered = [(b.inner_text() or b.evaluate("e => e.outerHTML.slice(0, 160)")) for b in page.get_by_role("button").all()
+               if b.is_visible() and (other := b.bounding_box()) and other != own and overlap(box, other)]
+    assert covered == [], covered
