@@ -7,8 +7,9 @@ import numpy as np
 import param
 
 from core.data import MeasuredStiffness
-from core.effects import EFFECTS
+from core.effects import EFFECTS, effect_title
 from core.identify.diagnose import BRANCHES, Diagnosis, diagnose
+from core.identify.fit import fitted_name
 from core.io.measured import parse_stiffness
 from core.io.table import csv_text
 from core.synthetic import MYSTERIES, Mystery
@@ -96,7 +97,8 @@ class DiagnosisState(param.Parameterized):
         if self.result is None:
             return
         design = self.result.final.design
-        self.explorer.adopt(design.replace(name=f"{self.explorer.design.name or 'Design'} (diagnosed)"))
+        # one name for a design whose values come from measured data, fitted here or in the fit tab
+        self.explorer.adopt(design.replace(name=fitted_name(self.explorer.design.name or "Design")))
 
     def truth(self) -> str:
         """The demo's truth in words, and whether the diagnosis found it."""
@@ -117,7 +119,7 @@ class DiagnosisState(param.Parameterized):
         if self.result is not None:
             found = sorted(self.result.added) == sorted(missing)
             said += " The diagnosis " + ("found exactly that." if found else
-                                         f"named {', '.join(self.result.added) or 'nothing'}.")
+                                         f"named {', '.join(map(effect_title, self.result.added)) or 'nothing'}.")
         return said
 
     # ---- data for the plots --------------------------------------------------------------------

@@ -7,7 +7,7 @@ import html
 import math
 
 import panel as pn
-from bokeh.models import CustomJSTickFormatter
+from bokeh.models import CustomJSTickFormatter, Tooltip
 
 from core.bushing import STRUCTURAL_EFFECTS, shape_factor
 from core.io.design_file import loads_design_upload
@@ -19,6 +19,15 @@ from .fields import DESIGN_FIELDS, GEOMETRY_FIELDS, MATERIAL_FIELDS
 from .state import ExplorerState
 from .units import OPERATING_FREQUENCIES, amplitude_unit
 from .uploads import design_dropper, on_upload
+
+
+def tip(text: str, anchor: str = "top_center") -> Tooltip:
+    """A button's description, shown when the pointer rests on it, centred on ``anchor`` of the
+    button (a Bokeh anchor: above it for ``top_*``, below for ``bottom_*``), placed where it
+    hides no other button: Panel's default, to its right, covered the next button of its row
+    (issue #27)."""
+    return Tooltip(content=text, position=anchor, attachment="above" if anchor.startswith("top") else "below",
+                   stylesheets=[":host { white-space: initial; max-width: 420px; }"])
 
 
 class FloatInput(pn.widgets.FloatInput):

@@ -5,7 +5,6 @@ tab's view (:mod:`app.tabs.what_ifs`) shows it."""
 
 from __future__ import annotations
 
-import asyncio
 import json
 import logging
 
@@ -17,6 +16,7 @@ from core.whatif.target import Found, TargetError, solve
 
 from . import units
 from .state import ExplorerState
+from .work import PageClosed, in_thread
 
 log = logging.getLogger("bushing.app")
 
@@ -46,6 +46,7 @@ class TargetsForm(param.Parameterized):
     mu_max_mpa = param.Number(default=None, allow_None=True, bounds=(0, None),
                               label=f"{MU.symbol} to ({MU.unit.display})")
     running = param.Boolean(default=False, doc="A search is under way.")
+    progress_message = param.String(default="", doc="Where the running search is (its start of how many).")
     found = param.Parameter(default=None, doc="The last search's core.whatif.target.Found.")
     message = param.String(default="", doc="Why the last search found nothing (empty after a search that ran).")
 
@@ -89,12 +90,13 @@ class TargetsForm(param.Parameterized):
         """The targets file's text (JSON, two-space indent, a final newline): the download."""
         return json.dumps(self.spec(), indent=2) + "\n"
 
-    def compute(self) -> Found:
-        """The search (pure: safe in a worker thread)."""
+    def compute(self, progress=None) -> Found:
+        """The search (pure: safe in a worker thread); ``progress(fraction, message)`` told of
+        each start (:func:`core.whatif.target.solve`)."""
         spec = self.spec()
         if not spec["targets"]:
             raise TargetError("give at least one target: |K|, a least loss factor or a radial/axial ratio")
-        return solve(problem_from_dict(spec))
+        return solve(problem_from_dict(spec), progress=progress)
 
     def run(self):
         """The search, on this thread (tests and scripts): its result in ``found`` or ``message``."""
@@ -103,23 +105,29 @@ class TargetsForm(param.Parameterized):
         except (TargetError, ValueError) as exc:
             self.param.update(found=None, message=str(exc))
 
-    async def search(self):
-        """The search in a worker thread (the page's button): one at a time; never raises (a
-        failure is its ``message``)."""
+    async def search(self, doc=None):
+        """The search in a worker thread (the page's button), its progress in ``progress_message``
+        as it goes (:func:`app.work.in_thread`; ``doc`` the page's document): one at a time;
+        never raises (a failure is its ``message``). A page closed meanwhile: nothing more is
+        set (its views would write to a closed page)."""
         if self.running:
             return
-        self.param.update(running=True, message="")
+        self.param.update(running=True, message="", progress_message="")
         try:
-            found = await asyncio.to_thread(self.compute)
+            found = await in_thread(self.compute, self._show_progress, doc)
+        except PageClosed:
+            return
         except (TargetError, ValueError) as exc:
-            self.param.update(found=None, message=str(exc))
+            self.param.update(found=None, message=str(exc), running=False)
         except Exception as exc:  # noqa: BLE001 - never a traceback in the page
             log.warning("design search failed: %s: %s", type(exc).__name__, exc)
-            self.param.update(found=None, message=f"The search failed ({type(exc).__name__}): {exc}")
+            self.param.update(found=None, message=f"The search failed ({type(exc).__name__}): {exc}",
+                              running=False)
         else:
-            self.param.update(found=found, message="")
-        finally:
-            self.running = False
+            self.param.update(found=found, message="", running=False)
+
+    def _show_progress(self, _fraction: float, message: str):
+        self.progress_message = message
 
     def rows(self) -> list:
         """The designs to show and take: the solutions, or the closest design when none meets

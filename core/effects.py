@@ -183,6 +183,13 @@ def effect_of(eid: str) -> Effect:
     return EFFECTS[split_id(eid)[0]]
 
 
+def effect_title(eid: str) -> str:
+    """The name a person reads for an effect id: its title, and the rig of a mode-tied one
+    ("Apparent mass seen by the force sensor on the torsion rig")."""
+    base, mode = split_id(eid)
+    return EFFECTS[base].title + (f" on the {mode} rig" if mode else "")
+
+
 def validate_effects(effects: Any) -> dict[str, dict[str, float]]:
     """Check an ``effects`` object of a design file; return it as plain floats.
 

@@ -202,7 +202,8 @@ def test_alpha_at_one_takes_a_one_sided_step():
 
 def test_the_sentence_names_what_dominates():
     text = sentence(elasticities(PAPER_B, 10.0, 1e-4))
-    assert text.startswith("|K| follows a most") and "the loss factor follows" in text
+    # each parameter named in words (issue #27: "follows a most" read as English)
+    assert text.startswith("|K| depends most on the inner radius a (") and "the loss factor depends most on the" in text
 
 
 # ---- designs from targets ---------------------------------------------------------------------

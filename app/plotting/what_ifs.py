@@ -12,6 +12,6 @@ from .style import (
 
 
 def sensitivity_bars(bars: hv.Bars, title: str, color: str, png: str) -> hv.Bars:
-    """Sensitivities as a bar chart, largest first (:mod:`core.whatif.sensitivity`)."""
+    """Sensitivities as a bar chart, in the order of ``bars`` (:mod:`core.whatif.sensitivity`)."""
     return bars.opts(title=title, color=color, responsive=True, height=260, framewise=True, tools=["hover"],
                      hooks=[canvas, png_name(png)], fontsize={"title": "13px"}, xrotation=0, show_legend=False)

@@ -3,23 +3,24 @@
 
 from __future__ import annotations
 
-import asyncio
 import io
 import logging
 
 import numpy as np
 import panel as pn
 
-from core.effects import EFFECTS
+from core.effects import EFFECTS, effect_title
 from core.identify.diagnose import BIC_THRESHOLD
 from core.material import ConvergenceError
 
 from ..diagnosis_state import DiagnosisState
-from ..live import LivePlot, update_or_keep
+from ..inputs import tip
+from ..live import LivePlot, one_change, update_or_keep
 from ..plotting.find_the_missing_effect import diagnosis_overlays
 from ..plotting.style import SWEEP_PALETTES, sweep_label
 from ..units import amplitude_unit
 from ..uploads import csv_dropper, on_upload
+from ..work import PageClosed, in_thread
 
 log = logging.getLogger("bushing.app")
 
@@ -34,8 +35,6 @@ not add effects to fit noise, and only if it explains most of the misfit), adds 
 repeats until what is left is noise, or says what remains unexplained.
 """
 
-
-PROGRESS_POLL_S = 0.15
 
 
 def _effect_card(eid: str) -> str:
@@ -54,13 +53,13 @@ class DiagnosisView(pn.viewable.Viewer):
         self.use_measured = pn.widgets.Button(label="Use the data of “Measured data and fit”", color="light")
         self.use_measured.on_click(lambda _e: state.use_measured())
         self.mystery = pn.widgets.Button(label="Load a mystery data set (demo)", color="light",
-                                         description="Synthetic data with an effect hidden in it (or none); "
-                                         "its bushing goes into the explorer. The truth is shown after the diagnosis.")
+                                         description=tip("Synthetic data with an effect hidden in it (or none); "
+                                         "its bushing goes into the explorer. The truth is shown after the diagnosis.", "bottom_center"))
         self.mystery.on_click(lambda _e: state.load_mystery())
         self.baseline = pn.widgets.CheckButtonGroup.from_param(state.param.baseline, color="primary",
                                                                variant="outline")
         self.run = pn.widgets.Button(label="Diagnose", color="primary",
-                                     description="Fit the baseline and every candidate effect; name what is missing.")
+                                     description=tip("Fit the baseline and every candidate effect; name what is missing."))
         self.run.on_click(self._run)
         self.progress = pn.indicators.Progress(value=0, max=100, visible=False, sizing_mode="stretch_width",
                                                bar_color="primary")
@@ -104,35 +103,36 @@ class DiagnosisView(pn.viewable.Viewer):
     # ---- events --------------------------------------------------------------------------------
 
     async def _run(self, _event):
+        """The diagnosis in a worker thread, its steps shown as they come (:func:`app.work.in_thread`);
+        the report and its plots replace the progress in one push. A page closed meanwhile gets
+        nothing more."""
         state = self.state
         if state.running:
             return
-        shared = [0.0, "starting"]  # written by the worker, read here on the event loop
-
-        def progress(fraction, message):
-            shared[:] = [fraction, message]
-
         state.param.update(running=True, message="", result=None, revealed=False, progress=0.0,
                            progress_message="fitting the baseline")
-        task = asyncio.ensure_future(asyncio.to_thread(state.compute, progress))
         try:
-            while not task.done():
-                await asyncio.wait({task}, timeout=PROGRESS_POLL_S)
-                state.param.update(progress=float(np.clip(shared[0], 0, 1)), progress_message=shared[1])
-            result = task.result()
+            result = await in_thread(state.compute, self._show_progress, pn.state.curdoc)
+        except PageClosed:
+            return  # nothing is written to a closed page's document, not even "running" ended
         except (ValueError, ConvergenceError) as exc:
-            state.message = str(exc)
+            with one_change():
+                state.param.update(message=str(exc), running=False)
         except Exception as exc:  # noqa: BLE001 - never a traceback in the page; one line in the log
             log.warning("diagnosis failed: %s: %s", type(exc).__name__, exc)
-            state.message = f"The diagnosis failed ({type(exc).__name__}): {exc}"
+            with one_change():
+                state.param.update(message=f"The diagnosis failed ({type(exc).__name__}): {exc}", running=False)
         else:
-            state.result = result
-        finally:
-            state.running = False
+            with one_change():
+                state.param.update(result=result, running=False, progress=1.0)
+
+    def _show_progress(self, fraction: float, message: str):
+        self.state.param.update(progress=fraction, progress_message=message)
 
     def _on_progress(self, *_events):
         self.progress.value = round(100 * self.state.progress)
-        self.progress_text.object = f"<i>{self.state.progress_message}…</i>" if self.state.running else ""
+        self.progress_text.object = (f'<i class="diagnosis-progress">{self.state.progress_message}…</i>'
+                                     if self.state.running else "")
 
     # ---- refresh -------------------------------------------------------------------------------
 
@@ -180,7 +180,7 @@ class DiagnosisView(pn.viewable.Viewer):
                                                    " (not determined)" if k in step.undetermined else "")
                                for k, v in step.parameters.items()) or "no parameters"
             partner = step.extra.get("found_with")
-            together = f" (found together with {partner})" if partner else ""
+            together = f" (found together with {effect_title(partner)})" if partner else ""
             support = step.support_words()
             lines.append(f"**Step {n}: add {EFFECTS[step.effect].title}**{together}"
                          f"{' *' + support + '*' if step.mode else ''}: {params}. Evidence: BIC "
@@ -190,7 +190,8 @@ class DiagnosisView(pn.viewable.Viewer):
             lines.append("> " + _effect_card(step.effect))
             others = sorted(((v, k) for k, v in step.candidates.items() if k != step.effect), reverse=True)[:3]
             if others:
-                lines.append("Other candidates' BIC drops: " + ", ".join(f"{k} {v:.1f}" for v, k in others) + ".")
+                lines.append("Other candidates' BIC drops: " + ", ".join(f"{effect_title(k)} {v:.1f}"
+                                                                         for v, k in others) + ".")
         if not r.steps:
             lines.append("**Nothing added**: no effect of the library is supported by the data.")
         if r.modes:

@@ -19,6 +19,7 @@ from core.synthetic import paper_b_example
 from .. import curves, units
 from ..curves import padded
 from ..fit_state import FIT_DEPENDS, FitState
+from ..inputs import tip
 from ..live import LivePlot
 from ..plotting.measured_data_and_fit import prediction_overlay, residual_overlays
 from ..plotting.style import ranged
@@ -53,8 +54,8 @@ class MeasuredView(PlotView):
         self.clear = pn.widgets.Button(label="Clear the data", color="light")
         self.clear.on_click(lambda _e: state.clear_measured())
         self.fit_button = pn.widgets.Button(label="Fit the five material parameters", color="primary",
-                                            description="Global fit to all loaded data from 8 starting points; "
-                                            "the current design is the first.")
+                                            description=tip("A global fit from 8 starting points, the current design first.",
+                                                            "top_right"))
         self.fit_button.on_click(self._fit)
         self.method = pn.widgets.RadioButtonGroup.from_param(fit.param.fit_method, description=fit.param.fit_method.doc)
         self.fit_on = pn.widgets.TextInput.from_param(fit.param.fit_on, description=fit.param.fit_on.doc,

@@ -10,14 +10,14 @@ import panel as pn
 import param
 
 from core.parameters import BY_NAME, GEOMETRY, NAMES
-from core.whatif.sensitivity import elasticities, ranked, sentence
+from core.whatif.sensitivity import elasticities, sentence
 from core.whatif.tolerance import ToleranceError
 
 from .. import curves, units
 from ..bands import band_tolerances, banded, tolerance_refusal
 from ..fit_state import FitState
 from ..inputs import FIELD_ERROR_STYLES, FloatInput, IntInput, field_error_html
-from ..live import LivePlot
+from ..live import LivePlot, one_change
 from ..plotting.what_ifs import sensitivity_bars
 from ..state import ExplorerState
 from ..targets_form import TargetsForm
@@ -39,7 +39,8 @@ fit's standard errors and correlations.
 SENSITIVITY_TEXT = """
 **Sensitivities at the operating point.** Bar length ∂ln|K|/∂ln p: a +1 % change of the parameter
 moves |K| by that many per cent. For the loss factor, ∂η/∂ln p: a +1 % change moves η by a
-hundredth of it. The bars follow the operating point.
+hundredth of it. Both charts list the parameters in the same order; the bars follow the
+operating point.
 """
 DESIGN_TEXT = """
 **Design from targets.** Ask for |K| (and, optionally, a least loss factor and a radial/axial
@@ -83,9 +84,10 @@ class WhatIfView(PlotView):
         self.sentence = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.bars: LivePlot | None = None
         self.form = TargetsForm(state)
-        self.form.param.watch(self._show_found, ["found", "message"])
+        self.form.param.watch(self._show_search, ["found", "message", "running", "progress_message"])
         self.find = pn.widgets.Button(label="Find designs", color="primary", width=160)
         self.find.on_click(self._run)
+        self.searching = pn.pane.HTML("", css_classes=["search-progress"], margin=(0, 10))
         self.solutions = pn.widgets.Select(label="Solution", options={}, width=420, visible=False)
         self.use = pn.widgets.Button(label="Take it into the explorer", color="success", visible=False)
         self.use.on_click(lambda _e: self.form.use_solution(self.solutions.value))
@@ -161,8 +163,8 @@ class WhatIfView(PlotView):
         items = []
         for quantity, label, color in (("magnitude", "∂ln|K| / ∂ln p", "#1f5f8b"),
                                        ("loss_factor", "∂η / ∂ln p", "#2ca02c")):
-            order = ranked(values, quantity)
-            bars = hv.Bars([(BY_NAME[n].symbol, v) for n, v in order], kdims=[hv.Dimension("parameter", label="Parameter")],
+            # both charts in the one parameter table's order: a parameter sits at one place in both
+            bars = hv.Bars([(BY_NAME[n].symbol, values[n][quantity]) for n in NAMES if n in values], kdims=[hv.Dimension("parameter", label="Parameter")],
                            vdims=[hv.Dimension(f"sensitivity_{quantity}", label=label)])
             title = "|K|: % per +1 % of the parameter" if quantity == "magnitude" else \
                 "Loss factor: change per unit ln p"
@@ -178,13 +180,20 @@ class WhatIfView(PlotView):
         return io.StringIO(self.form.targets_text())
 
     async def _run(self, _event):
-        if self.form.running:
-            return  # one search at a time: the button shows the running one
-        self.find.loading = True
-        try:
-            await self.form.search()
-        finally:
-            self.find.loading = False
+        """The search in a worker thread (:meth:`app.targets_form.TargetsForm.search`); its
+        progress beside the button; the result replaces it in one push (:meth:`_show_search`)."""
+        await self.form.search(pn.state.curdoc)
+
+    def _show_search(self, *events):
+        """The search's state: the button busy and where the search is while it runs, then its
+        result, all in one message to the page."""
+        form = self.form
+        with one_change():
+            self.find.loading = form.running
+            self.searching.object = (f"<i>Searching: {form.progress_message}…</i>"
+                                     if form.running and form.progress_message else "")
+            if any(e.name in ("found", "message") for e in events):
+                self._show_found()
 
     def _show_found(self, *_events):
         found = self.form.found
@@ -229,7 +238,7 @@ class WhatIfView(PlotView):
             pn.FlexBox(w(self.form.param.mu_min_mpa, width=150), w(self.form.param.mu_max_mpa, width=150),
                        pn.pane.HTML("<i>A µ range lets the compound vary too.</i>", margin=(28, 10)),
                        sizing_mode="stretch_width"),
-            pn.Row(self.find, self.targets_file),
+            pn.Row(self.find, self.targets_file, self.searching),
             self.result, pn.Row(self.solutions, self.use), sizing_mode="stretch_width")
         return pn.Column(
             pn.pane.Markdown(TOLERANCE_TEXT, sizing_mode="stretch_width"), tol_grid, self.band_controls,

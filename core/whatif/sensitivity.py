@@ -62,10 +62,18 @@ def ranked(values: dict[str, dict[str, float]], quantity: str) -> list[tuple[str
 
 
 def sentence(values: dict[str, dict[str, float]]) -> str:
-    """What dominates, in one sentence."""
+    """What dominates, in one sentence: each parameter named in words with its symbol
+    ("|K| depends most on the inner radius a"), never a bare symbol that reads as a word."""
     (k1, e1), (k2, e2) = ranked(values, "magnitude")[:2]
     (l1, d1) = ranked(values, "loss_factor")[0]
-    s1, s2, s3 = (BY_NAME[n].symbol for n in (k1, k2, l1))
-    return (f"|K| follows {s1} most (+1 % in {s1} gives {e1:+.2f} % in |K|), then "
-            f"{s2} ({e2:+.2f} %); the loss factor follows {s3} most "
+    n1, n2, n3 = (_named(n) for n in (k1, k2, l1))
+    s1, s3 = BY_NAME[k1].symbol, BY_NAME[l1].symbol
+    return (f"|K| depends most on {n1} (+1 % in {s1} gives {e1:+.2f} % in |K|), then on "
+            f"{n2} ({e2:+.2f} %); the loss factor depends most on {n3} "
             f"(+1 % in {s3} moves it by {d1 / 100:+.2g}).")
+
+
+def _named(name: str) -> str:
+    """A parameter in a sentence: "the inner radius a"."""
+    label = BY_NAME[name].label
+    return f"the {label[0].lower()}{label[1:]}"

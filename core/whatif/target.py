@@ -24,6 +24,7 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -270,9 +271,12 @@ def _solution(problem: Problem, z: np.ndarray) -> Solution:
                     tuple(t.measure(design) for t in problem.targets), _binding(problem, z, design))
 
 
-def solve(problem: Problem, starts: int = STARTS, seed: int = 0) -> Found:
+def solve(problem: Problem, starts: int = STARTS, seed: int = 0,
+          progress: Callable[[float, str], None] | None = None) -> Found:
     """Search ``problem`` (:class:`Problem`): the feasible designs nearest the start, or the
-    closest miss with the reason. ``seconds`` in the result is for the user's information only."""
+    closest miss with the reason. ``seconds`` in the result is for the user's information only.
+    ``progress(fraction, message)`` is told of each start as the search reaches it."""
+    say = progress or (lambda fraction, message: None)
     t0 = time.perf_counter()
     lo, hi = problem.bounds()
     centre = np.log([problem.values(problem.start)[v] for v in problem.variables])
@@ -282,10 +286,12 @@ def solve(problem: Problem, starts: int = STARTS, seed: int = 0) -> Found:
     # (the same search again when no target is a number: skipped)
     exact = any(t.value is not None for t in problem.targets)
     evaluators = (_Evaluator(problem, exact=True), _Evaluator(problem)) if exact else (_Evaluator(problem),)
-    for ev in evaluators:
-        for z0 in points:
+    for n, ev in enumerate(evaluators):
+        for i, z0 in enumerate(points):
             if sum(e.spent for e in evaluators) >= TARGET_EVALUATIONS:
                 break
+            say((n + i / len(points)) / len(evaluators),
+                f"{'within the tolerance: ' if n else ''}start {i + 1} of {len(points)}")
             constraints = [{"type": "ineq", "fun": ev.margins}]
             if len(ev.equalities(z0)):
                 constraints.append({"type": "eq", "fun": ev.equalities})

@@ -11,7 +11,7 @@ import numpy as np
 
 from ...data import MAX_FIT_POINTS, MeasuredStiffness
 from ...design import Design
-from ...effects import effect_of, split_id
+from ...effects import effect_of, effect_title, split_id
 from ...material import ConvergenceError
 from ...registry import parameter, parameter_values
 from ...residuals import gap, gaps_by_mode, relative_residual
@@ -154,7 +154,7 @@ def _best_pair(current: Fitted, tried: dict[str, Fitted], drops: dict[str, float
         for b in ranked[i + 1:]:
             if b not in candidates(tried[a].model, modes):
                 continue
-            say(done, f"trying {_title(a).lower()} with {_title(b).lower()}")
+            say(done, f"trying {effect_title(a).lower()} with {effect_title(b).lower()}")
             joint = _fit_candidate(tried[a], b, data, origin)
             if joint is None:
                 continue
@@ -194,7 +194,8 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
         tried: dict[str, Fitted] = {}
         span = (0.8 - done) / 2
         for i, eid in enumerate(names):
-            say(done + span * i / len(names), f"step {len(accepted) + 1}: trying {_title(eid).lower()}")
+            say(done + span * i / len(names), f"step {len(accepted) + 1}, candidate {i + 1} of {len(names)}: "
+                f"{effect_title(eid).lower()}")
             fitted = _fit_candidate(current, eid, data, origin)
             if fitted is not None:
                 tried[eid] = fitted
@@ -271,15 +272,11 @@ def diagnose(design: Design, data: MeasuredStiffness, *, baseline: Iterable[str]
     if held_out:
         say(0.85, "checking on held-out data")
         held = _held_out(measured, {"baseline": first, "final": current})
-    say(1.0, "done")
+    say(0.95, "describing where the models miss the data")
     where_first, where_final = where(first), where(current) if remaining else "no misfit above the noise."
+    say(1.0, "done")
     return Diagnosis(measured, on(first), steps, on(current), noise, remaining, where_first, where_final, held,
                      disagreement)
-
-
-def _title(effect_id: str) -> str:
-    base, mode = split_id(effect_id)
-    return effect_of(base).title + (f" on the {mode} rig" if mode else "")
 
 
 def _words(data: MeasuredStiffness, k: np.ndarray, mode: str, sd: float) -> str:

@@ -1,0 +1,194 @@
+"""Waiting in the browser (issue #27, items 12 and 13): a wait shows its progress until the result
+replaces it, the diagnosis names its candidates in words, and the two sensitivity charts list the
+parameters in one order. Each test waits for the state it then checks, never for a time."""
+
+import re
+import threading
+
+import numpy as np
+import pytest
+from playwright.sync_api import expect
+
+from tests.ui.bokeh_page import FIGURE_JS, open_explorer
+
+pytestmark = pytest.mark.usefixtures("console_errors", "no_server_tracebacks")
+
+# in the page, from now on: every painted frame's text (Panel's panes live in shadow roots, which
+# neither innerText nor a MutationObserver sees into): whether progress was shown, whether a
+# finished progress ("done…") was ever shown without the report, whether the report ever came
+# with the progress still shown, and the report's first frame's text
+WATCH_JS = """([progress, report]) => {
+  const deepText = (node) => {
+    let out = node.innerText ?? [...node.children].map(c => c.innerText ?? '').join(' ');
+    for (const el of node.querySelectorAll('*')) if (el.shadowRoot) out += ' ' + deepText(el.shadowRoot);
+    return out;
+  };
+  const seen = window.bushingWait = {progress: [], doneAlone: false, progressWithReport: false, report: null};
+  const look = () => {
+    const text = deepText(document.body);
+    const shown = text.match(new RegExp(progress));
+    const hasReport = new RegExp(report).test(text);
+    if (shown && !seen.progress.includes(shown[0])) seen.progress.push(shown[0]);
+    if (/\\bdone…/.test(text) && !hasReport) seen.doneAlone = true;
+    if (hasReport) {
+      if (shown) seen.progressWithReport = true;
+      seen.report = text;
+      return;
+    }
+    requestAnimationFrame(look);
+  };
+  requestAnimationFrame(look);
+}"""
+
+
+def watch(page, progress: str, report: str):
+    page.evaluate(WATCH_JS, [progress, report])
+
+
+def wait_report(page, timeout=120_000) -> dict:
+    page.wait_for_function("() => window.bushingWait.report !== null", timeout=timeout)
+    return page.evaluate("() => window.bushingWait")
+
+
+def upload_150_points(page, tmp_path):
+    from core import PAPER_B
+    from core.synthetic import synthetic_stiffness
+
+    # a hidden fixture mass of 0.5 kg: 30 frequencies × 5 amplitudes, 0.5 % noise
+    hidden = PAPER_B.replace(effects={"inertia": {"mass": 0.5}})
+    measured = tmp_path / "inertia.csv"
+    synthetic_stiffness(hidden, np.linspace(1, 100, 30), [0.013e-3, 0.04e-3, 0.1e-3, 0.17e-3, 0.35e-3],
+                        noise=0.005, seed=3).to_csv(measured)
+    page.get_by_text("Find the missing effect", exact=True).click()
+    page.get_by_role("button", name="Diagnose").wait_for()
+    page.locator("input[type=file]").last.set_input_files(str(measured))
+    page.get_by_text("150 points").first.wait_for()
+
+
+def test_the_diagnosis_shows_its_progress_until_its_report_replaces_it(page, explorer_url, tmp_path):
+    """150 points diagnosed: the page shows which candidate of how many is being fitted, never a
+    finished progress ("done…") without the report, and the report arrives with the progress
+    gone (once: "done…" for 2.2 s before the report)."""
+    open_explorer(page, explorer_url)
+    upload_150_points(page, tmp_path)
+    watch(page, r"(fitting|trying|candidate \d+ of \d+|profiling|checking|describing)[^…]*…", "What is left is noise")
+    page.get_by_role("button", name="Diagnose").click()
+    seen = wait_report(page)
+    assert not seen["doneAlone"], seen["progress"]
+    assert not seen["progressWithReport"]
+    assert len(seen["progress"]) >= 2, seen["progress"]  # the steps reached the page as they came
+    assert any(re.search(r"candidate \d+ of \d+: ", p) for p in seen["progress"]), seen["progress"]
+    expect(page.locator(".diagnosis-progress")).to_have_count(0)
+
+
+def test_the_diagnosis_names_its_candidates(page, explorer_url, tmp_path):
+    """The other candidates of a step are listed by their names, as the library titles them
+    (once by their ids: "viscous 3.1, stiffening 0.4")."""
+    from core.effects import EFFECTS
+
+    open_explorer(page, explorer_url)
+    upload_150_points(page, tmp_path)
+    page.get_by_role("button", name="Diagnose").click()
+    line = page.get_by_text("Other candidates' BIC drops:").first
+    line.wait_for(timeout=120_000)
+    listed = line.inner_text().split(":", 1)[1].strip().rstrip(".")
+    names = [re.sub(r"\s+-?\d+(\.\d+)?$", "", item.strip()) for item in listed.split(", ")]
+    titles = {e.title for e in EFFECTS.values()}
+    assert names and all(n in titles for n in names), names
+
+
+# the x factors of each bar chart of the What-ifs tab
+FACTORS_JS = f"""(title) => {{ const m = ({FIGURE_JS})(title); return m === null ? null : Array.from(m.x_range.factors); }}"""
+CHARTS = ("|K|: % per +1 % of the parameter", "Loss factor: change per unit ln p")
+
+
+def test_the_sensitivity_charts_list_the_parameters_alike(page, explorer_url):
+    """Both sensitivity charts list the parameters in the order of the one parameter table, and
+    the sentence names them in words (once: each chart ranked by its own sizes; "|K| follows a
+    most")."""
+    from core.parameters import BY_NAME, NAMES
+
+    open_explorer(page, explorer_url)
+    page.get_by_text("What-ifs", exact=True).click()
+    for title in CHARTS:
+        page.wait_for_function(f"(title) => ({FACTORS_JS})(title)?.length > 0", arg=title, timeout=60_000)
+    k, eta = (page.evaluate(FACTORS_JS, title) for title in CHARTS)
+    assert k == eta == [BY_NAME[n].symbol for n in NAMES]
+    expect(page.get_by_text(re.compile(r"\|K\| depends most on the [a-z]"))).to_have_count(1)
+
+
+@pytest.fixture
+def gated_search(monkeypatch):
+    """*Find designs* held at its sixth start until the test has seen the page say so:
+    ``(reached, release)`` events."""
+    from app.targets_form import TargetsForm
+
+    reached, release = threading.Event(), threading.Event()
+    compute = TargetsForm.compute
+
+    def gated(self, progress=None):
+        def say(fraction, message):
+            if progress is not None:
+                progress(fraction, message)
+            if message == "start 6 of 12":
+                reached.set()
+                release.wait(60)
+
+        return compute(self, say)
+
+    monkeypatch.setattr(TargetsForm, "compute", gated)
+    return reached, release
+
+
+def test_find_designs_shows_where_the_search_is_until_its_result(page, explorer_url, gated_search):
+    """While *Find designs* runs, the page says which start of how many it has reached, and the
+    result replaces that line (once: a spinning button only, whatever the wait)."""
+    reached, release = gated_search
+    open_explorer(page, explorer_url)
+    page.get_by_text("What-ifs", exact=True).click()
+    target = page.get_by_label("|K| target")
+    target.fill("4.5")
+    target.press("Enter")
+    watch(page, r"Searching: start \d+ of \d+…", r"every target\.|cannot be met")
+    page.get_by_role("button", name="Find designs").click()
+    try:
+        expect(page.get_by_text("Searching: start 6 of 12…")).to_be_visible(timeout=60_000)
+        assert reached.is_set()  # shown while the search was held there
+    finally:
+        release.set()
+    seen = wait_report(page)
+    assert "Searching: start 6 of 12…" in seen["progress"]
+    assert not seen["progressWithReport"]
+    expect(page.get_by_text(re.compile("Searching: "))).to_have_count(0)
+
+
+# (tab, button, the start of its description)
+DESCRIBED = (
+    ("Measured data and fit", "Fit the five material parameters", "8 starting points"),
+    ("Find the missing effect", "Load a mystery data set (demo)", "Synthetic data with an effect"),
+    ("Find the missing effect", "Diagnose", "Fit the baseline and every candidate"),
+)
+
+
+def overlap(a: dict, b: dict) -> bool:
+    return (a["x"] < b["x"] + b["width"] and b["x"] < a["x"] + a["width"]
+            and a["y"] < b["y"] + b["height"] and b["y"] < a["y"] + a["height"])
+
+
+@pytest.mark.parametrize(("tab", "button", "description"), DESCRIBED)
+def test_a_buttons_description_covers_no_other_button(page, explorer_url, tab, button, description):
+    """The pointer resting on a button shows its description where it hides no other button
+    (once: to its right, over the next button of its row)."""
+    open_explorer(page, explorer_url)
+    page.get_by_text(tab, exact=True).click()
+    hovered = page.get_by_role("button", name=button, exact=True)
+    hovered.wait_for()
+    hovered.scroll_into_view_if_needed()
+    hovered.hover(force=True)  # a disabled button shows its description too
+    shown = page.get_by_text(description).first
+    expect(shown).to_be_visible()
+    box = shown.bounding_box()
+    own = hovered.bounding_box()
+    covered = [(b.inner_text() or b.evaluate("e => e.outerHTML.slice(0, 160)")) for b in page.get_by_role("button").all()
+               if b.is_visible() and (other := b.bounding_box()) and other != own and overlap(box, other)]
+    assert covered == [], covered
