@@ -10,6 +10,7 @@ from ..curves import amplitude_bounds, amplitude_grid, branch_breakdown, hystere
 from ..live import LivePlot, update_or_keep
 from ..plotting.fletcher_gent import branch_overlays, loop_shape_overlay
 from ..plotting.style import ranged
+from ..shapes import shape_pane
 from ..state import ExplorerState
 from ..units import amplitude_unit
 from ..views import PlotView
@@ -80,6 +81,7 @@ class TeachingView(PlotView):
     def __panel__(self):
         return pn.Column(
             pn.pane.Markdown(TEACHING_TEXT, sizing_mode="stretch_width"),
+            shape_pane(self.state),
             pn.Row(
                 pn.Column(*self.branches.panes, sizing_mode="stretch_width"),
                 pn.Column(self.player, self.frame_label, self.loop.pane, sizing_mode="stretch_width"),

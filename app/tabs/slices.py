@@ -9,6 +9,7 @@ from ..curves import amplitude_grid, padded, slice_comparison
 from ..live import LivePlot
 from ..plotting.slices import SLICE_NAMES, slices_overlays
 from ..plotting.style import ranged
+from ..shapes import shape_pane
 from ..state import ExplorerState
 from ..units import amplitude_unit
 from ..views import PlotView
@@ -67,6 +68,7 @@ class SlicesView(PlotView):
                 "its own equivalent strain; the continuum takes infinitely many. The single "
                 "equivalent modulus (eqs 17/18) is close when the differences below are small. "
                 "All at the loop frequency; tap a plot to move the amplitude.", sizing_mode="stretch_width"),
+            shape_pane(self.state),
             self.table,
             *self.plots.panes,
             sizing_mode="stretch_width",
