@@ -14,7 +14,7 @@ from core import Design
 from core.parameters import THESIS_MODES
 
 # the thesis' closed form of each mode that has one (docs/model.md)
-LONG_EQUATIONS = {"torsion": "eq 17", "axial": "eq 18"}
+LONG_EQUATIONS = {"torsion": 17, "axial": 18}
 
 
 def card_basis(design: Design) -> Design:
@@ -35,21 +35,25 @@ def shape_used(design: Design, mode: str | None = None) -> str:
     few words: "long-bushing formula (eq 18)" or "finite-length table"."""
     mode = mode or design.mode
     if design.shape != "finite" and mode in LONG_EQUATIONS:
-        return f"long-bushing formula ({LONG_EQUATIONS[mode]})"
+        return f"long-bushing formula (eq {LONG_EQUATIONS[mode]})"
     return "finite-length table"
 
 
 def shape_phrase(design: Design, modes: tuple[str, ...] | None = None) -> str:
     """The one sentence each view shows: "Shape factor: …" for ``design``'s own mode, or for
-    each of ``modes`` (those with the same shape factor named together)."""
+    each of ``modes`` (those with the same kind of shape factor named together)."""
     if modes is None:
         return f"Shape factor: {shape_used(design)}."
-    by_kind: dict[str, list[str]] = {}
-    for mode in modes:
-        by_kind.setdefault(shape_used(design, mode), []).append(mode)
-    if len(by_kind) == 1:
-        return f"Shape factor: {next(iter(by_kind))}, every direction."
-    return "Shape factor: " + "; ".join(f"{' and '.join(ms)}, {kind}" for kind, ms in by_kind.items()) + "."
+    long = [m for m in modes if shape_used(design, m) != "finite-length table"]
+    finite = [m for m in modes if m not in long]
+    if not long:
+        return "Shape factor: finite-length table, every direction."
+    plural = "s" if len(long) > 1 else ""
+    eqs = ", ".join(str(LONG_EQUATIONS[m]) for m in long)
+    parts = [f"{' and '.join(long)}, long-bushing formula{plural} (eq{plural} {eqs})"]
+    if finite:
+        parts.append(f"{' and '.join(finite)}, finite-length table")
+    return "Shape factor: " + "; ".join(parts) + "."
 
 
 def shape_note_html(design: Design, modes: tuple[str, ...] | None = None) -> str:
