@@ -11,10 +11,7 @@ with :func:`shape_phrase`.
 from __future__ import annotations
 
 from core import Design
-from core.parameters import THESIS_MODES
-
-# the thesis' closed form of each mode that has one (docs/model.md)
-LONG_EQUATIONS = {"torsion": 17, "axial": 18}
+from core.parameters import MODE, THESIS_MODES
 
 
 def card_basis(design: Design) -> Design:
@@ -34,8 +31,8 @@ def shape_used(design: Design, mode: str | None = None) -> str:
     """The shape factor ``design``'s setting gives direction ``mode`` (default: its own), in a
     few words: "long-bushing formula (eq 18)" or "finite-length table"."""
     mode = mode or design.mode
-    if design.shape != "finite" and mode in LONG_EQUATIONS:
-        return f"long-bushing formula (eq {LONG_EQUATIONS[mode]})"
+    if design.shape != "finite" and mode in THESIS_MODES:  # the thesis' closed forms (docs/model.md)
+        return f"long-bushing formula (eq {MODE[mode].long_equation})"
     return "finite-length table"
 
 
@@ -49,7 +46,7 @@ def shape_phrase(design: Design, modes: tuple[str, ...] | None = None) -> str:
     if not long:
         return "Shape factor: finite-length table, every direction."
     plural = "s" if len(long) > 1 else ""
-    eqs = ", ".join(str(LONG_EQUATIONS[m]) for m in long)
+    eqs = ", ".join(str(MODE[m].long_equation) for m in long)
     parts = [f"{' and '.join(long)}, long-bushing formula{plural} (eq{plural} {eqs})"]
     if finite:
         parts.append(f"{' and '.join(finite)}, finite-length table")

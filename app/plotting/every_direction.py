@@ -5,7 +5,7 @@ from __future__ import annotations
 import holoviews as hv
 
 from core import Design
-from core.parameters import ROTATIONS, TRANSLATIONS
+from core.parameters import MODE, ROTATIONS, TRANSLATIONS
 
 from .. import curves
 from ..shapes import card_basis
@@ -20,9 +20,10 @@ from .style import (
     sized,
 )
 
-# each direction's |K| plot, in the order of the tab's grid (translations, then rotations)
-DIRECTION_TITLES = {"axial": "|K| axial (along the axis)", "radial": "|K| radial (across the axis)",
-                    "torsion": "|K| torsion (about the axis)", "conical": "|K| conical (tilting)"}
+
+def direction_title(mode: str) -> str:
+    """The title of a direction's |K| plot: "|K| axial: the sleeves moved apart along the axis"."""
+    return f"|K| {mode}: {MODE[mode].description}"
 
 
 def card_dimensions() -> dict[str, hv.Dimension]:
@@ -59,7 +60,7 @@ def card_overlays(data: dict, dims: dict, at: dict, reference: dict | None = Non
                                    **REFERENCE_STYLE))
             items += [curve(data[m]["amplitude"], data[m]["magnitude"], xdim, ydim, m, color=MODE_COLORS[m],
                             line_width=2), marker(at[which], xdim)]
-            out[m] = overlay(items, DIRECTION_TITLES[m], f"bushing-card-{m}", logx=True, height=240)
+            out[m] = overlay(items, direction_title(m), f"bushing-card-{m}", logx=True, height=240)
         items = [band_area(data[m]["amplitude"], *data[m]["loss_factor_band"], xdim, dims["loss"], f"{m} band",
                            MODE_COLORS[m]) for m in modes if "loss_factor_band" in data[m]]
         if reference is not None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import panel as pn
 
-from ..curves import amplitude_grid, padded, slice_comparison
+from ..curves import amplitude_grid, branch_breakdown, padded, slice_comparison
 from ..live import LivePlot
 from ..plotting.slices import SLICE_NAMES, slices_overlays
 from ..plotting.style import ranged
@@ -20,7 +20,7 @@ WHICH = ("magnitude", "magnitude_diff_pct", "loss_factor")
 class SlicesView(PlotView):
     """One equivalent modulus against 2 and 3 slices and the continuum, at the loop frequency."""
 
-    shows = ("design", "frequency", "amplitude")
+    shows = ("design", "frequency", "amplitude", "reference")
 
     NAMES = SLICE_NAMES
 
@@ -37,7 +37,8 @@ class SlicesView(PlotView):
         s = self.state
         data = slice_comparison(s.design, s.frequency_hz, amplitude_grid(s.design, 60))
         dims = ranged(self.dims_for(self.state.design.mode), {"amplitude": padded([data["amplitude"]], log=True)})
-        overlays = slices_overlays(data, dims, self.state.amplitude)
+        reference = same_mode_reference(s, data["amplitude"])
+        overlays = slices_overlays(data, dims, self.state.amplitude, reference)
         items = [overlays[w] for w in WHICH]
         self.plots = LivePlot.shown(self.plots, items, taps={i: self.tap_amplitude for i in range(len(WHICH))})
         self.table.object = self.summary(data)
@@ -73,3 +74,13 @@ class SlicesView(PlotView):
             *self.plots.panes,
             sizing_mode="stretch_width",
         )
+
+
+def same_mode_reference(state: ExplorerState, amplitudes) -> dict | None:
+    """The pinned reference's material model at ``amplitudes`` (display units) and the loop
+    frequency (:func:`app.curves.branch_breakdown`: |K|, the loss factor, Re K and the loss
+    factor branch by branch), or None: no reference, or one in another mode (other units)."""
+    ref = state.reference
+    if ref is None or ref.mode != state.design.mode:
+        return None
+    return branch_breakdown(ref, state.frequency_hz, amplitudes)
