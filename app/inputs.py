@@ -16,7 +16,7 @@ from core.rules import RuleError
 
 from .curves import amplitude_bounds
 from .fields import DESIGN_FIELDS, GEOMETRY_FIELDS, MATERIAL_FIELDS
-from .state import ExplorerState
+from .state import PRESETS, ExplorerState
 from .units import OPERATING_FREQUENCIES, amplitude_unit
 from .uploads import design_dropper, on_upload
 
@@ -151,9 +151,13 @@ class DesignInputs(pn.viewable.Viewer):
                 state.param[name], description=state.param[name].doc, step=1.0,
                 sizing_mode="stretch_width", label=state.param[name].label,
             )
-        self.preset = pn.widgets.Select.from_param(
-            state.param.preset, description=state.param.preset.doc, sizing_mode="stretch_width",
+        self.preset = pn.widgets.Select(
+            name=state.param.preset.label, options=[*PRESETS, CUSTOM], value=shown_preset(state.design),
+            description=state.param.preset.doc + f" “{CUSTOM}”: the design is none of them.",
+            sizing_mode="stretch_width",
         )
+        self.preset.param.watch(self._pick_preset, "value")
+        state.param.watch(lambda e: setattr(self.preset, "value", shown_preset(e.new)), "design")
         self.mode = pn.widgets.RadioButtonGroup.from_param(
             state.param.mode, description=state.param.mode.doc, color="primary",
             variant="outline", sizing_mode="stretch_width",
@@ -167,6 +171,15 @@ class DesignInputs(pn.viewable.Viewer):
                                    lambda: amplitude_unit(state.design.mode))
         self.frequency = LogSlider(state, "frequency_hz", lambda: OPERATING_FREQUENCIES, lambda: "Hz")
         self.design_file = DesignFile(state)
+
+    def _pick_preset(self, event):
+        """A preset picked: the state loads it (again, if it was the last one picked)."""
+        if event.new not in PRESETS or self.state.design == PRESETS[event.new]:
+            return  # "Custom", or the select following the design
+        if self.state.preset == event.new:
+            self.state.param.trigger("preset")
+        else:
+            self.state.preset = event.new
 
     def _field(self, name):
         return pn.Column(self.widgets[name], error_text(self.state, name), margin=0, sizing_mode="stretch_width")
@@ -199,6 +212,14 @@ class DesignInputs(pn.viewable.Viewer):
                     sizing_mode="stretch_width"),
             sizing_mode="stretch_width",
         )
+
+
+CUSTOM = "Custom"  # the preset select's entry for a design that is none of the presets
+
+
+def shown_preset(design) -> str:
+    """The preset select's entry for ``design``: the preset's name if it is one, else :data:`CUSTOM`."""
+    return next((name for name, preset in PRESETS.items() if design == preset), CUSTOM)
 
 
 def shape_comparison(design) -> str:

@@ -40,11 +40,14 @@ figure is printed with its ratio to each floor's.
 same way (served with that tree as the working directory, so its packages are imported), prints
 its figures and the ratios now / before, and removes the worktree. ``--chromium`` adds the real
 browser's medians: slider to the last plot painted and typed field to the operating-point text
-painted (``app_latency.py``'s way: the change set on the page's Bokeh model), each change
-started once the page's document has been quiet for ``--quiet`` seconds.
+painted (``app_latency.py``'s way: the change set on the page's Bokeh model), and the mode
+switch axial ⇄ torsion (the mode buttons' model set, as a click does) to the operating-point text
+and every plot painted, each change started once the page's document has been quiet for
+``--quiet`` seconds. ``--chromium-only`` skips the websocket level and the floors.
 
 Targets of issue #26: server CPU ≤ 60 ms per amplitude change; Chromium slider-to-screen median
-≤ 100 ms; typed field to operating-point text median ≤ 150 ms.
+≤ 100 ms; typed field to operating-point text median ≤ 150 ms. Of issue #27 (item 16): mode
+switch to screen median ≤ 300 ms.
 
 The figures of the issue come from the one command (REV: the commit before the work on #26,
 7298e26; without ``--before`` only the working tree and the floors)::
@@ -349,6 +352,43 @@ TEXT_JS = """async ([title, value]) => {
 }"""
 
 
+# Chromium: a mode switch (the mode buttons' model set to ``index``, as a click does) to the
+# operating-point text and every plot painted: the time of the later of the text's paint and the
+# last plot change's paint (a plot change followed by ``quiet`` ms without one ends the wait)
+MODE_JS = """async ([index, quiet]) => {
+  const doc = Bokeh.documents[0];
+  const buttons = [...doc.all_models].find(m => (m.labels || []).includes('torsion') && m.active !== undefined);
+  const text = [...doc.all_models].find(m => (m.css_classes || []).includes('operating-point'));
+  const PLOT = new Set(['ColumnDataSource', 'DataRange1d', 'Range1d', 'Span', 'LegendItem', 'Legend', 'LinearAxis',
+                        'LogAxis', 'Title', 'Figure']);
+  const before = text.text;
+  let lastPaint = null, lastChange = null, textPaint = null;
+  const cb = (ev) => {
+    if (!ev.model || !PLOT.has(ev.model.type)) return;
+    lastChange = performance.now();
+    requestAnimationFrame(() => { lastPaint = performance.now(); });
+  };
+  doc.on_change(cb);
+  const t0 = performance.now();
+  buttons.active = index;
+  const ok = await new Promise(resolve => {
+    const tick = () => {
+      if (textPaint === null && text.text !== before) {
+        textPaint = -1;
+        requestAnimationFrame(() => { textPaint = performance.now(); });
+      }
+      if (textPaint > 0 && lastChange !== null && performance.now() - lastChange > quiet && lastPaint >= lastChange)
+        resolve(true);
+      else if (performance.now() - t0 > 20000) resolve(false);
+      else setTimeout(tick, 2);
+    };
+    tick();
+  });
+  doc.remove_on_change(cb);
+  return ok ? Math.max(lastPaint, textPaint) - t0 : null;
+}"""
+
+
 # wait until the page's document has had no change for ``quiet`` ms (the last change's plots and
 # its URL update drawn), then one animation frame: the next change starts on an idle page
 QUIET_JS = """async (quiet) => {
@@ -364,9 +404,11 @@ QUIET_JS = """async (quiet) => {
 }"""
 
 
-async def chromium(cwd: Path, n: int, quiet: float) -> dict:
+async def chromium(cwd: Path, n: int, quiet: float, modes: int | None = None) -> dict:
     """Medians in Chromium: the slider to the last plot painted (app_latency.py's CHANGE_JS),
-    the typed shear modulus to the operating-point text painted."""
+    the typed shear modulus to the operating-point text painted, and ``modes`` (default ``n``)
+    mode switches, axial ⇄ torsion, to the text and every plot painted (:data:`MODE_JS`)."""
+    modes = n if modes is None else modes
     from app_latency import ARGS, CHANGE_JS, CHROMIUM, open_page
     from playwright.async_api import async_playwright
 
@@ -382,7 +424,7 @@ async def chromium(cwd: Path, n: int, quiet: float) -> dict:
             lo, hi = await page.evaluate("""(t) => { const m = [...Bokeh.documents[0].all_models]
                 .find(m => m.title === t); return [m.start, m.end]; }""", slider)
             amps = [round(lo + f * (hi - lo), 4) for f in (0.3, 0.45, 0.6, 0.75)]
-            out = {"slider": [], "field": []}
+            out = {"slider": [], "field": [], "mode": []}
             for i in range(n + 2):  # two warm-up changes of each
                 ms = await page.evaluate(CHANGE_JS, [slider, amps[i % 4], 150])
                 await page.evaluate(QUIET_JS, 1000 * quiet)
@@ -393,6 +435,13 @@ async def chromium(cwd: Path, n: int, quiet: float) -> dict:
                 if i >= 2:
                     out["slider"].append(ms)
                     out["field"].append(typed)
+            for i in range(modes + 2):  # axial → torsion → axial …, two warm-up switches
+                switched = await page.evaluate(MODE_JS, [(i + 1) % 2, 150])
+                await page.evaluate(QUIET_JS, 1000 * quiet)
+                if switched is None:
+                    raise RuntimeError("Chromium: no answer to a mode switch within 20 s")
+                if i >= 2:
+                    out["mode"].append(switched)
             await browser.close()
     finally:
         stop(proc)
@@ -400,26 +449,32 @@ async def chromium(cwd: Path, n: int, quiet: float) -> dict:
           f"(p90 {pct(out['slider'], 90):6.1f})   target ≤ 100 ms")
     print(f"  typed field to text        median {statistics.median(out['field']):6.1f} ms "
           f"(p90 {pct(out['field'], 90):6.1f})   target ≤ 150 ms")
+    if out["mode"]:
+        print(f"  mode switch to screen      median {statistics.median(out['mode']):6.1f} ms "
+              f"(p90 {pct(out['mode'], 90):6.1f})   target ≤ 300 ms")
     return out
 
 
-def measure_tree(name: str, cwd: Path, n: int, quiet: float, with_chromium: bool) -> dict:
-    """The explorer of the tree at ``cwd``, at the websocket level and (optionally) in Chromium."""
-    out = {"ws": explorer(cwd, n, quiet)}
-    report(f"explorer ({name}), websocket level:", out["ws"])
-    print(f"  target: server CPU per amplitude change ≤ 60 ms: {statistics.median(out['ws']['amplitude']['cpu']):.1f}"
-          " ms (median, answer)")
+def measure_tree(name: str, cwd: Path, n: int, quiet: float, with_chromium: bool, websocket: bool = True) -> dict:
+    """The explorer of the tree at ``cwd``, at the websocket level (unless not ``websocket``) and
+    (optionally) in Chromium."""
+    out = {}
+    if websocket:
+        out["ws"] = explorer(cwd, n, quiet)
+        report(f"explorer ({name}), websocket level:", out["ws"])
+        print(f"  target: server CPU per amplitude change ≤ 60 ms: "
+              f"{statistics.median(out['ws']['amplitude']['cpu']):.1f} ms (median, answer)")
     if with_chromium:
         print(f"explorer ({name}), Chromium:")
         out["chromium"] = asyncio.run(chromium(cwd, n, quiet))
     return out
 
 
-def main(n: int, quiet: float, rev: str | None, with_chromium: bool, floors: bool):
+def main(n: int, quiet: float, rev: str | None, with_chromium: bool, floors: bool, websocket: bool = True):
     print(f"{n} changes of each kind after 4 warm-up changes; a change has answered when the "
           f"document has been quiet for {quiet:.2f} s; CPU and latency in ms per change")
-    now = measure_tree("working tree", HERE.parent, n, quiet, with_chromium)
-    if floors:
+    now = measure_tree("working tree", HERE.parent, n, quiet, with_chromium, websocket)
+    if floors and websocket:
         for name, script in (("bare Bokeh floor", "bokeh_floor.py"), ("bare HoloViews floor", "holoviews_floor.py")):
             proc, url = start_floor(script)
             floor = measure_server(proc, url, n, quiet)
@@ -427,12 +482,13 @@ def main(n: int, quiet: float, rev: str | None, with_chromium: bool, floors: boo
             ratios(f"explorer / {name}:", now["ws"], floor)
     if rev:
         with worktree(rev) as tree:
-            old = measure_tree(f"before, {rev}", tree, n, quiet, with_chromium)
-        ratios(f"now / before ({rev}), websocket level:", now["ws"], old["ws"])
+            old = measure_tree(f"before, {rev}", tree, n, quiet, with_chromium, websocket)
+        if websocket:
+            ratios(f"now / before ({rev}), websocket level:", now["ws"], old["ws"])
         if with_chromium:
             print(f"now / before ({rev}), Chromium medians: "
                   + "   ".join(f"{k} {statistics.median(now['chromium'][k]) / statistics.median(old['chromium'][k]):.2f}"
-                             for k in ("slider", "field")))
+                             for k in ("slider", "field", "mode") if now["chromium"][k] and old["chromium"][k]))
 
 
 if __name__ == "__main__":
@@ -442,5 +498,6 @@ if __name__ == "__main__":
     ap.add_argument("--before", metavar="REV", help="also measure the explorer of this git revision")
     ap.add_argument("--chromium", action="store_true", help="also the medians in Chromium")
     ap.add_argument("--no-floors", dest="floors", action="store_false", help="skip the bare floors")
+    ap.add_argument("--chromium-only", action="store_true", help="only the Chromium medians (no websocket level)")
     a = ap.parse_args()
-    main(a.changes, a.quiet, a.before, a.chromium, a.floors)
+    main(a.changes, a.quiet, a.before, a.chromium or a.chromium_only, a.floors, websocket=not a.chromium_only)

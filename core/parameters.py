@@ -158,6 +158,7 @@ class Mode:
     default_shape: str  # the shape factor used unless a design names one (SHAPES)
     on_axis: bool  # along or about the bushing's axis (one direction); else across it (two alike)
     long_form: bool = True  # a closed form of a long bushing exists (the shape "long" is allowed)
+    long_equation: int | None = None  # the thesis' equation of its long-bushing shape factor, if it has one
 
     @property
     def rotation(self) -> bool:
@@ -182,9 +183,9 @@ MODE_TABLE: tuple[Mode, ...] = (
     # axial and torsion: the thesis' closed forms (eqs 17, 18); radial and conical have none that
     # holds at real lengths, so the finite-length table (core.shape)
     Mode("axial", "translation", "the sleeves moved apart along the axis", "Displacement",
-         default_shape="long", on_axis=True, **_TRANSLATION),
+         default_shape="long", on_axis=True, long_equation=18, **_TRANSLATION),
     Mode("torsion", "rotation", "the sleeves turned about the axis", "Angle", default_shape="long", on_axis=True,
-         **_ROTATION),
+         long_equation=17, **_ROTATION),
     Mode("radial", "translation", "the sleeves moved apart across the axis", "Displacement",
          default_shape="finite", on_axis=False, **_TRANSLATION),
     Mode("conical", "rotation", "the sleeves tilted about a diameter", "Tilt angle", default_shape="finite",

@@ -7,6 +7,7 @@ import pytest
 
 from app import units
 from app.main import App
+from app.shapes import card_basis
 from core import PAPER_B, stiffness
 from core.bushing import shape_factor, strain_factor
 from core.card import card
@@ -62,13 +63,16 @@ def test_the_card_tab_holds_the_core_card(app):
     view = app.card
     app.tabs.active = [t for t, *_ in App.LAZY_TABS].index("Every direction") + 1  # shown: it refreshes
     view.param.update(displacement_mm=0.2, angle_rad=0.02)
-    rows = card(app.state.design, app.state.frequency_hz, 0.2e-3, 0.02)
+    rows = card(card_basis(app.state.design), app.state.frequency_hz, 0.2e-3, 0.02)
+    # the axial row is the explorer's own stiffness (one shape-factor setting): long by default
+    explorer_axial = stiffness(app.state.design, app.state.frequency_hz, 0.2e-3).magnitude[0, 0]
+    assert rows[0]["mode"] == "axial" and rows[0]["magnitude"] == pytest.approx(explorer_axial, rel=1e-12)
     for r in rows:
         assert f"{units.display_stiffness(r['magnitude'], r['mode']):.4g}" in view.table.object
     radial = next(r for r in rows if r["mode"] == "radial")["magnitude"]
     axial = next(r for r in rows if r["mode"] == "axial")["magnitude"]
     assert f"radial / axial **{radial / axial:.2f}**" in view.table.object
-    x, y = xy(view.frame("translation"), "radial")
+    x, y = xy(view.frame("radial"), "radial")
     assert len(x) == 60 and np.all(np.diff(y) < 0)  # the radial stiffness softens with amplitude
     _, eta = xy(view.frame("rotation_loss"), "conical")
     assert np.all(np.isfinite(eta)) and eta.max() > eta[0]  # the loss factor's Fletcher–Gent peak
@@ -94,4 +98,4 @@ def test_exports_and_the_plotting_api_in_a_new_direction(app):
     first = values[:, 1] == values[0, 1]
     np.testing.assert_allclose(values[first, 4], ref.magnitude[0, first], rtol=1e-10)
     layout = card_plots(PAPER_B, 10.0)
-    assert isinstance(layout, hv.Layout) and len(layout) == 4
+    assert isinstance(layout, hv.Layout) and len(layout) == 6

@@ -24,8 +24,8 @@ CHANGES = {
     "finite length": (lambda s: setattr(s, "finite_length", True), dict.fromkeys(VIEWS, True)),
     "an input that is not a number": (lambda s: setattr(s, "length_mm", None), dict.fromkeys(VIEWS, False)),
     "a pinned reference": (lambda s: s.pin_reference(),
-                           {"plots": True, "compare": True, "slices": False, "teaching": False, "measured": False,
-                            "card": False, "whatif": False}),
+                           {"plots": True, "compare": True, "slices": True, "teaching": True, "measured": False,
+                            "card": True, "whatif": False}),
 }
 
 

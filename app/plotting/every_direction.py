@@ -1,17 +1,18 @@
-"""The Every direction tab's plots: the bushing card, |K| and the loss factor of every direction.
-"""
+"""The Every direction tab's plots: the bushing card, |K| and the loss factor of every direction."""
 
 from __future__ import annotations
 
 import holoviews as hv
 
 from core import Design
-from core.parameters import ROTATIONS, TRANSLATIONS
+from core.parameters import MODE, ROTATIONS, TRANSLATIONS
 
 from .. import curves
+from ..shapes import card_basis
 from ..units import ROTATION, TRANSLATION
 from .style import (
     MODE_COLORS,
+    REFERENCE_STYLE,
     band_area,
     curve,
     marker,
@@ -20,35 +21,56 @@ from .style import (
 )
 
 
+def direction_title(mode: str) -> str:
+    """The title of a direction's |K| plot: "|K| axial: the sleeves moved apart along the axis"."""
+    return f"|K| {mode}: {MODE[mode].description}"
+
+
 def card_dimensions() -> dict[str, hv.Dimension]:
-    """The card's axes: translations and rotations apart (their units differ)."""
-    return {
+    """The card's axes: translations and rotations apart (their units differ), and each
+    direction's |K| on its own axis (radial is several times axial: on one axis the smaller
+    would be squashed flat)."""
+    dims = {
         "displacement": hv.Dimension("card_displacement", label="Displacement amplitude",
                                      unit=TRANSLATION.amplitude.display),
         "angle": hv.Dimension("card_angle", label="Angle amplitude", unit=ROTATION.amplitude.display),
-        "k_translation": hv.Dimension("card_k_translation", label="|K|", unit=TRANSLATION.stiffness.display),
-        "k_rotation": hv.Dimension("card_k_rotation", label="|K|", unit=ROTATION.stiffness.display),
         "loss": hv.Dimension("card_loss", label="Loss factor"),
     }
+    for m in TRANSLATIONS + ROTATIONS:
+        unit = (TRANSLATION if m in TRANSLATIONS else ROTATION).stiffness.display
+        dims[f"k_{m}"] = hv.Dimension(f"card_k_{m}", label=f"|K| {m}", unit=unit)
+    return dims
 
 
-def card_overlays(data: dict, dims: dict, at: dict) -> dict:
-    """The card (:func:`app.curves.card_sweeps`) as four plots: |K| and the loss factor of the
-    translations against displacement, of the rotations against angle; ``at`` the card's
-    displacement and angle (display units)."""
+def card_overlays(data: dict, dims: dict, at: dict, reference: dict | None = None) -> dict:
+    """The card (:func:`app.curves.card_sweeps`) as six plots: each direction's |K| on its own
+    axes (``axial``, ``radial`` against displacement, ``torsion``, ``conical`` against angle),
+    and the loss factors of the translations and of the rotations (one material: one loss axis);
+    ``at`` the card's displacement and angle (display units); ``reference`` the pinned
+    reference's card sweeps, drawn dashed, if any."""
     out = {}
-    for which, modes, xdim, ydim, title in (
-            ("translation", TRANSLATIONS, dims["displacement"], dims["k_translation"],
-             "|K| along and across the axis"),
-            ("rotation", ROTATIONS, dims["angle"], dims["k_rotation"], "|K| turning and tilting")):
-        for quantity, y_dim, name in (("magnitude", ydim, which), ("loss_factor", dims["loss"], f"{which}_loss")):
-            items = [band_area(data[m]["amplitude"], *data[m][f"{quantity}_band"], xdim, y_dim, f"{m} band",
-                               MODE_COLORS[m]) for m in modes if f"{quantity}_band" in data[m]]
-            items += [curve(data[m]["amplitude"], data[m][quantity], xdim, y_dim, m, color=MODE_COLORS[m],
-                            line_width=2) for m in modes]
-            items.append(marker(at[which], xdim))
-            label = title if quantity == "magnitude" else f"Loss factor, {title[4:]}"
-            out[name] = overlay(items, label, f"bushing-card-{name.replace('_', '-')}", logx=True, height=260)
+    for which, modes, xdim in (("translation", TRANSLATIONS, dims["displacement"]),
+                               ("rotation", ROTATIONS, dims["angle"])):
+        for m in modes:
+            ydim = dims[f"k_{m}"]
+            items = [band_area(data[m]["amplitude"], *data[m]["magnitude_band"], xdim, ydim, f"{m} band",
+                               MODE_COLORS[m])] if "magnitude_band" in data[m] else []
+            if reference is not None:
+                items.append(curve(reference[m]["amplitude"], reference[m]["magnitude"], xdim, ydim, "reference",
+                                   **REFERENCE_STYLE))
+            items += [curve(data[m]["amplitude"], data[m]["magnitude"], xdim, ydim, m, color=MODE_COLORS[m],
+                            line_width=2), marker(at[which], xdim)]
+            out[m] = overlay(items, direction_title(m), f"bushing-card-{m}", logx=True, height=240)
+        items = [band_area(data[m]["amplitude"], *data[m]["loss_factor_band"], xdim, dims["loss"], f"{m} band",
+                           MODE_COLORS[m]) for m in modes if "loss_factor_band" in data[m]]
+        if reference is not None:
+            items += [curve(reference[m]["amplitude"], reference[m]["loss_factor"], xdim, dims["loss"],
+                            f"reference {m}", **REFERENCE_STYLE) for m in modes]
+        items += [curve(data[m]["amplitude"], data[m]["loss_factor"], xdim, dims["loss"], m, color=MODE_COLORS[m],
+                        line_width=2) for m in modes]
+        items.append(marker(at[which], xdim))
+        title = "Loss factor, along and across the axis" if which == "translation" else "Loss factor, turning and tilting"
+        out[f"{which}_loss"] = overlay(items, title, f"bushing-card-{which}-loss", logx=True, height=240)
     return out
 
 
@@ -59,7 +81,10 @@ def card_plots(design: Design, frequency_hz: float = 10.0, displacement: float =
     Parameters
     ----------
     design : Design
-        The bushing, in SI units, in any mode: the card takes it into every mode.
+        The bushing, in SI units, in any mode: the card takes it into every mode, with the
+        explorer's shape factors (:func:`app.shapes.card_basis`: the finite-length table in every
+        direction if its ``shape`` is ``finite``, else the long-bushing formulas of axial and
+        torsion).
     frequency_hz : float, default 10.0
         The frequency in Hz.
     displacement : float, default 1e-4
@@ -72,11 +97,11 @@ def card_plots(design: Design, frequency_hz: float = 10.0, displacement: float =
     Returns
     -------
     holoviews.Layout
-        Four plots in two columns: |K| of the translations (kN/mm) against displacement (mm)
-        and of the rotations (N·m/rad) against angle (rad), and their loss factors
-        (dimensionless).
+        Six plots in two columns: |K| of axial and radial (kN/mm) against displacement (mm),
+        of torsion and conical (N·m/rad) against angle (rad), each on its own axes, and the
+        loss factors (dimensionless) of the translations and of the rotations.
     """
-    data = curves.card_sweeps(design, frequency_hz)
+    data = curves.card_sweeps(card_basis(design), frequency_hz)
     at = {"translation": TRANSLATION.amplitude.to_display(displacement),
           "rotation": ROTATION.amplitude.to_display(angle)}
     return sized(hv.Layout(list(card_overlays(data, card_dimensions(), at).values())).cols(2), width)

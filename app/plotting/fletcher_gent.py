@@ -12,6 +12,7 @@ from core import Design
 from .. import curves
 from .style import (
     BRANCH_COLORS,
+    REFERENCE_STYLE,
     curve,
     dimensions,
     marker,
@@ -22,9 +23,10 @@ from .style import (
 )
 
 
-def branch_overlays(data: dict, dims: dict, at: float) -> dict:
+def branch_overlays(data: dict, dims: dict, at: float, reference: dict | None = None) -> dict:
     """Re K and the loss factor against amplitude as stacked areas, branch by branch
-    (:func:`app.curves.branch_breakdown`)."""
+    (:func:`app.curves.branch_breakdown`); ``reference`` the pinned reference's breakdown at the
+    same amplitudes, its totals drawn dashed, if any."""
     out = {}
     for which, title, ydim in (("real", "Re K, branch by branch (stacked)", dims["real"]),
                                ("loss", "Loss factor, branch by branch (stacked)", dims["branch_loss"])):
@@ -36,6 +38,9 @@ def branch_overlays(data: dict, dims: dict, at: float) -> dict:
                                 vdims=[ydim, hv.Dimension(f"{which}_base")], label=name, color=color,
                                 fill_alpha=0.55, line_alpha=0))
             base = top
+        if reference is not None:
+            areas.append(curve(data["amplitude"], sum(reference[which].values()), dims["amplitude"], ydim,
+                               "reference", **REFERENCE_STYLE))
         areas.append(marker(at, dims["amplitude"]))
         out[which] = overlay(areas, title, f"bushing-branches-{which}", logx=True, legend="top_left")
     return out

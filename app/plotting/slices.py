@@ -1,5 +1,4 @@
-"""The Slices tab's plots: Paper A's sliced bushing against the single equivalent modulus.
-"""
+"""The Slices tab's plots: Paper A's sliced bushing against the single equivalent modulus."""
 
 from __future__ import annotations
 
@@ -9,6 +8,7 @@ from core import Design
 
 from .. import curves
 from .style import (
+    REFERENCE_STYLE,
     curve,
     dimensions,
     marker,
@@ -21,9 +21,11 @@ SLICE_COLORS = {1: "#1f77b4", 2: "#ff7f0e", 3: "#2ca02c", "continuum": "#9467bd"
 SLICE_NAMES = {1: "1 slice (eqs 17/18)", 2: "2 slices", 3: "3 slices", "continuum": "continuum"}
 
 
-def slices_overlays(data: dict, dims: dict, at: float) -> dict:
+def slices_overlays(data: dict, dims: dict, at: float, reference: dict | None = None) -> dict:
     """Paper A's comparison (:func:`app.curves.slice_comparison`) as three plots against
-    amplitude: |K|, its difference from the single modulus in %, and the loss factor."""
+    amplitude: |K|, its difference from the single modulus in %, and the loss factor;
+    ``reference`` the pinned reference's single-modulus |K| and loss factor at the same
+    amplitudes (:func:`app.curves.branch_breakdown`), drawn dashed, if any."""
     specs = {"magnitude": ("|K|: single modulus, slices and continuum", dims["magnitude"], (1, 2, 3, "continuum")),
              "magnitude_diff_pct": ("|K| difference from the single modulus (%)", dims["difference"], (2, 3, "continuum")),
              "loss_factor": ("Loss factor", dims["loss_factor"], (1, 2, 3, "continuum"))}
@@ -34,6 +36,9 @@ def slices_overlays(data: dict, dims: dict, at: float) -> dict:
             y = data[which].get(m)
             items.append(curve(data["amplitude"] if y is not None else [], y if y is not None else [],
                                dims["amplitude"], ydim, SLICE_NAMES[m], color=SLICE_COLORS[m], line_width=2))
+        if reference is not None and which in reference:
+            items.append(curve(data["amplitude"], reference[which], dims["amplitude"], ydim, "reference",
+                               **REFERENCE_STYLE))
         items.append(marker(at, dims["amplitude"]))
         out[which] = overlay(items, title, f"bushing-slices-{which}", logx=True, height=280)
     return out

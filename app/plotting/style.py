@@ -15,6 +15,7 @@ import holoviews as hv
 import holoviews.plotting.bokeh
 import numpy as np
 from bokeh.models import SaveTool
+from holoviews.core.util import dimension_sanitizer
 
 from core.parameters import MODES
 from core.parameters import mode as mode_of
@@ -185,14 +186,38 @@ def styled(kind: str, data, **options):
     return template(kind, key).clone(data, **fields)
 
 
-def curve(x, y, xdim, ydim, label, **style):
+# the first line of every hover tooltip: the hovered glyph's legend label (its renderer's name,
+# set by :func:`hover_names`), so that a tooltip says which of the plot's curves it reads
+CURVE_TIP = ("curve", "$name")
+
+
+def hover_names(plot, element):
+    """A hook naming the element's glyph renderer after its legend label (the tooltips'
+    ``$name``, :data:`CURVE_TIP`), once."""
+    renderer = plot.handles.get("glyph_renderer")
+    if renderer is not None and renderer.name != element.label:
+        renderer.name = element.label
+
+
+def _hovered(style: dict, *dims: hv.Dimension) -> dict:
+    """``style`` with a hover tool whose tooltips name the curve, then read its ``dims`` (label
+    and unit): one tooltip list per set of dimensions, so an overlay merges its curves' tools."""
     style.setdefault("tools", ["hover"])
+    if "hover" in style["tools"]:
+        style.setdefault("hover_tooltips", [CURVE_TIP, *((d.pprint_label, f"@{{{dimension_sanitizer(d.name)}}}")
+                                                         for d in dims)])
+        style["hooks"] = [*style.get("hooks", []), hover_names]
+    return style
+
+
+def curve(x, y, xdim, ydim, label, **style):
+    _hovered(style, xdim, ydim)
     return styled("Curve", (np.asarray(x, dtype=float), np.asarray(y, dtype=float)),
                   kdims=[xdim], vdims=[ydim], label=label, **style)
 
 
 def scatter(x, y, xdim, ydim, label, **style):
-    style.setdefault("tools", ["hover"])
+    _hovered(style, xdim, ydim)
     return styled("Scatter", (np.asarray(x, dtype=float), np.asarray(y, dtype=float)),
                   kdims=[xdim], vdims=[ydim], label=label, **style)
 
@@ -224,7 +249,7 @@ def band_area(x, low, high, xdim: hv.Dimension, ydim: hv.Dimension, label: str, 
     upper = _band_top(ydim.name, ydim.label, ydim.unit)
     return styled("Area", (np.asarray(x, dtype=float), np.asarray(low, dtype=float), np.asarray(high, dtype=float)),
                   kdims=[xdim], vdims=[ydim, upper], label=label, color=color, fill_alpha=0.22, line_alpha=0.0,
-                  tools=["hover"])
+                  **_hovered({}, xdim, ydim, upper))
 
 
 def band_label(percentiles) -> str:

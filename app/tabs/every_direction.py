@@ -7,7 +7,7 @@ from __future__ import annotations
 import panel as pn
 import param
 
-from core.card import card, card_design, ratios
+from core.card import CARD_MODES, card, ratios
 from core.parameters import MODE, ROTATIONS, TRANSLATIONS
 from core.shape import long_shape_factor
 
@@ -19,25 +19,29 @@ from ..inputs import FloatInput
 from ..live import LivePlot
 from ..plotting.every_direction import card_dimensions, card_overlays
 from ..plotting.style import ranged
+from ..shapes import card_basis, shape_pane, shape_used
 from ..state import ExplorerState
 from ..units import ROTATION, TRANSLATION
 from ..views import PlotView
 
-WHICH = ("translation", "translation_loss", "rotation", "rotation_loss")
+# the grid, two columns: each direction's |K| (translations, then rotations), then the loss factors
+WHICH = (*TRANSLATIONS, *ROTATIONS, "translation_loss", "rotation_loss")
 TEXT = """
 **Every direction of the bushing.** The same rubber and geometry loaded four ways: **axial** (the
 sleeves moved apart along the axis), **radial** (across it), **torsion** (turned about it) and
-**conical** (tilted about a diameter). Finite-length shape factors from the finite-element table
-(the design's long-bushing setting keeps the thesis' formulas for axial and torsion); each
-direction has its own equivalent strain, so the Fletcher–Gent softening sets in at a different
-drive in each (at the same equivalent strain, the loss factors are the same: one material).
+**conical** (tilted about a diameter). The shape factors follow the sidebar's *Finite-length shape
+factor* switch: off, axial and torsion use the thesis' long-bushing formulas, radial and conical
+the finite-length table (they have no formula that holds at real lengths); on, the finite-length
+table everywhere. Each row of the table names its own. Each direction has its own equivalent
+strain, so the Fletcher–Gent softening sets in at a different drive in each (at the same
+equivalent strain, the loss factors are the same: one material). Each |K| has its own axes.
 """
 
 
 class CardView(PlotView):
     """The bushing card at the operating frequency."""
 
-    shows = ("design", "frequency", "bands")
+    shows = ("design", "frequency", "bands", "reference")
     own = ("displacement_mm", "angle_rad")
 
     displacement_mm = param.Number(0.1, bounds=(1e-6, 100.0),
@@ -61,7 +65,8 @@ class CardView(PlotView):
         return self.plots.current[WHICH.index(which)]
 
     def _update(self):
-        design, f = self.state.design, self.state.frequency_hz
+        design, f = card_basis(self.state.design), self.state.frequency_hz
+        reference = self.state.reference
         x = float(TRANSLATION.amplitude.to_si(self.displacement_mm))  # m
         angle = float(ROTATION.amplitude.to_si(self.angle_rad))  # rad
         try:
@@ -70,22 +75,28 @@ class CardView(PlotView):
         except ValueError as exc:  # outside the finite-length table, or an effect with no card
             self.table.object = f"_The card is not available for this design: {exc}_"
             return
+        try:
+            shown_reference = None if reference is None else card_sweeps(card_basis(reference), f)
+        except ValueError:  # a reference with no card: the design's card alone
+            shown_reference = None
         tolerances = band_tolerances(**self.state.band_inputs(), fit_result=self.fit.fit_result)
         for mode, b in (banded(tolerances, lambda tol: card_bands(design, f, tol))[0] or {}).items():
             data[mode].update(b)
         self.table.object = self.summary(design, f, rows)
-        dims = ranged(self.dims, {axis: padded([data[m]["amplitude"] for m in modes], log=True)
+        swept = [data] if shown_reference is None else [data, shown_reference]  # a reference's drives differ
+        dims = ranged(self.dims, {axis: padded([d[m]["amplitude"] for d in swept for m in modes], log=True)
                                   for axis, modes in (("displacement", TRANSLATIONS), ("angle", ROTATIONS))})
         at = {"translation": TRANSLATION.amplitude.to_display(x), "rotation": ROTATION.amplitude.to_display(angle)}
-        overlays = card_overlays(data, dims, at)
+        overlays = card_overlays(data, dims, at, shown_reference)
         self.plots = LivePlot.shown(self.plots, [overlays[w] for w in WHICH])
 
     @staticmethod
     def summary(design, frequency_hz, rows) -> str:
         g = design.geometry
         lines = [f"**At {frequency_hz:.3g} Hz** ({design.name or 'this design'})", "",
-                 "| direction | amplitude | \\|K\\| | loss factor | shape factor S | S / long-bushing formula |",
-                 "|---|---|---|---|---|---|"]
+                 ("| direction | amplitude | \\|K\\| | loss factor | shape factor used | S "
+                 "| S / long-bushing formula |"),
+                 "|---|---|---|---|---|---|---|"]
         for r in rows:
             mode = r["mode"]
             amp = units.display_amplitude(r["amplitude"], mode)
@@ -95,15 +106,15 @@ class CardView(PlotView):
                 versus = f"{r['shape_factor'] / long_shape_factor(g.inner_radius, g.outer_radius, g.length, mode):.3f}"
             except ValueError:
                 versus = "no formula"
-            used = card_design(design, mode).shape_kind
-            lines.append(f"| {mode} ({used}) | {amp:.3g} {units.amplitude_unit(mode)} | {k:.4g} "
-                         f"{units.stiffness_unit(mode)} | {r['loss_factor']:.4f} | {r['shape_factor']:.4g} {s_unit} "
-                         f"| {versus} |")
+            lines.append(f"| {mode} | {amp:.3g} {units.amplitude_unit(mode)} | {k:.4g} "
+                         f"{units.stiffness_unit(mode)} | {r['loss_factor']:.4f} | {shape_used(design, mode)} "
+                         f"| {r['shape_factor']:.4g} {s_unit} | {versus} |")
         q = ratios(design, rows)
         lines += ["", (f"**Ratios**: radial / axial **{q['radial/axial']:.2f}**; radial / torsion-equivalent "
                        f"(K_torsion / r_m², r_m = (a + b)/2) **{q['radial/torsion-equivalent']:.2f}**.")]
         return "\n".join(lines)
 
     def __panel__(self):
-        return pn.Column(pn.pane.Markdown(TEXT, sizing_mode="stretch_width"), self.inputs, self.table,
+        return pn.Column(pn.pane.Markdown(TEXT, sizing_mode="stretch_width"), shape_pane(self.state, CARD_MODES),
+                         self.inputs, self.table,
                          self.plots.grid(2), sizing_mode="stretch_width")

@@ -13,6 +13,7 @@ from ..bands import band_tolerances, banded
 from ..fit_state import FitState
 from ..live import LivePlot
 from ..plotting.explorer import explorer_overlays
+from ..shapes import shape_pane
 from ..state import ExplorerState
 from ..views import PlotView
 
@@ -70,7 +71,7 @@ class ExplorerPlots(PlotView):
         )
 
     def __panel__(self):
-        return pn.Column(self.summary, self.loop.pane, self.grid.grid(2), sizing_mode="stretch_width")
+        return pn.Column(self.summary, shape_pane(self.state), self.loop.pane, self.grid.grid(2), sizing_mode="stretch_width")
 
 
 def band_words(p: dict, unit: str) -> str:

@@ -9,6 +9,7 @@ import logging
 import numpy as np
 import panel as pn
 
+from core.card import CARD_MODES
 from core.effects import EFFECTS, effect_title
 from core.identify.diagnose import BIC_THRESHOLD
 from core.material import ConvergenceError
@@ -18,6 +19,7 @@ from ..inputs import tip
 from ..live import LivePlot, one_change, update_or_keep
 from ..plotting.find_the_missing_effect import diagnosis_overlays
 from ..plotting.style import SWEEP_PALETTES, sweep_label
+from ..shapes import shape_pane
 from ..units import amplitude_unit
 from ..uploads import csv_dropper, on_upload
 from ..work import PageClosed, in_thread
@@ -240,6 +242,7 @@ class DiagnosisView(pn.viewable.Viewer):
             pn.Row(pn.Column("**Stiffness CSV**", self.file, sizing_mode="stretch_width"),
                    pn.Column(self.use_measured, self.mystery), sizing_mode="stretch_width"),
             self.source,
+            shape_pane(self.state.explorer, CARD_MODES),
             self.message,
             "### 2. Baseline and diagnosis",
             pn.Row(self.baseline, self.run),

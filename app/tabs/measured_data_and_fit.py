@@ -23,6 +23,7 @@ from ..inputs import tip
 from ..live import LivePlot
 from ..plotting.measured_data_and_fit import prediction_overlay, residual_overlays
 from ..plotting.style import ranged
+from ..shapes import shape_pane
 from ..state import ExplorerState, measured_amplitudes
 from ..uploads import csv_dropper, on_files, on_upload
 from ..views import PlotView
@@ -209,6 +210,7 @@ class MeasuredView(PlotView):
                    pn.Column("**Loop CSV** (optional)", self.loop_file, sizing_mode="stretch_width"),
                    sizing_mode="stretch_width"),
             pn.Row(self.example, self.clear),
+            shape_pane(self.state),
             self.message,
             self.summary,
             pn.Row(self.method, self.sweep, self.fit_on),

@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 import panel as pn
 
-from ..curves import amplitude_grid, padded, slice_comparison
+from ..curves import amplitude_grid, branch_breakdown, padded, slice_comparison
 from ..live import LivePlot
 from ..plotting.slices import SLICE_NAMES, slices_overlays
 from ..plotting.style import ranged
+from ..shapes import shape_pane
 from ..state import ExplorerState
 from ..units import amplitude_unit
 from ..views import PlotView
@@ -19,7 +20,7 @@ WHICH = ("magnitude", "magnitude_diff_pct", "loss_factor")
 class SlicesView(PlotView):
     """One equivalent modulus against 2 and 3 slices and the continuum, at the loop frequency."""
 
-    shows = ("design", "frequency", "amplitude")
+    shows = ("design", "frequency", "amplitude", "reference")
 
     NAMES = SLICE_NAMES
 
@@ -36,7 +37,8 @@ class SlicesView(PlotView):
         s = self.state
         data = slice_comparison(s.design, s.frequency_hz, amplitude_grid(s.design, 60))
         dims = ranged(self.dims_for(self.state.design.mode), {"amplitude": padded([data["amplitude"]], log=True)})
-        overlays = slices_overlays(data, dims, self.state.amplitude)
+        reference = same_mode_reference(s, data["amplitude"])
+        overlays = slices_overlays(data, dims, self.state.amplitude, reference)
         items = [overlays[w] for w in WHICH]
         self.plots = LivePlot.shown(self.plots, items, taps={i: self.tap_amplitude for i in range(len(WHICH))})
         self.table.object = self.summary(data)
@@ -67,7 +69,18 @@ class SlicesView(PlotView):
                 "its own equivalent strain; the continuum takes infinitely many. The single "
                 "equivalent modulus (eqs 17/18) is close when the differences below are small. "
                 "All at the loop frequency; tap a plot to move the amplitude.", sizing_mode="stretch_width"),
+            shape_pane(self.state),
             self.table,
             *self.plots.panes,
             sizing_mode="stretch_width",
         )
+
+
+def same_mode_reference(state: ExplorerState, amplitudes) -> dict | None:
+    """The pinned reference's material model at ``amplitudes`` (display units) and the loop
+    frequency (:func:`app.curves.branch_breakdown`: |K|, the loss factor, Re K and the loss
+    factor branch by branch), or None: no reference, or one in another mode (other units)."""
+    ref = state.reference
+    if ref is None or ref.mode != state.design.mode:
+        return None
+    return branch_breakdown(ref, state.frequency_hz, amplitudes)

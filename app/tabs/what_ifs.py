@@ -9,6 +9,7 @@ import holoviews as hv
 import panel as pn
 import param
 
+from core.card import CARD_MODES
 from core.parameters import BY_NAME, GEOMETRY, NAMES
 from core.whatif.sensitivity import elasticities, sentence
 from core.whatif.tolerance import ToleranceError
@@ -19,6 +20,7 @@ from ..fit_state import FitState
 from ..inputs import FIELD_ERROR_STYLES, FloatInput, IntInput, field_error_html
 from ..live import LivePlot, one_change
 from ..plotting.what_ifs import sensitivity_bars
+from ..shapes import card_basis, shape_pane
 from ..state import ExplorerState
 from ..targets_form import TargetsForm
 from ..views import PlotView
@@ -135,7 +137,7 @@ class WhatIfView(PlotView):
         _, reason = banded(tolerances, lambda tol: curves.operating_bands(design, f, x, s.freq_range, tol))
         if not reason:
             try:
-                _, reason = banded(tolerances, lambda tol: curves.card_bands(design, f, tol))
+                _, reason = banded(tolerances, lambda tol: curves.card_bands(card_basis(design), f, tol))
             except ValueError:  # no card for this design: its tab says so
                 pass
         if s.band_on and reason:
@@ -241,7 +243,7 @@ class WhatIfView(PlotView):
             pn.Row(self.find, self.targets_file, self.searching),
             self.result, pn.Row(self.solutions, self.use), sizing_mode="stretch_width")
         return pn.Column(
-            pn.pane.Markdown(TOLERANCE_TEXT, sizing_mode="stretch_width"), tol_grid, self.band_controls,
+            pn.pane.Markdown(TOLERANCE_TEXT, sizing_mode="stretch_width"), shape_pane(self.state, CARD_MODES), tol_grid, self.band_controls,
             self.band_status,
             pn.pane.Markdown(SENSITIVITY_TEXT, sizing_mode="stretch_width"), self.sentence, self.bars.grid(2),
             pn.pane.Markdown(DESIGN_TEXT, sizing_mode="stretch_width"), form,

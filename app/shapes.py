@@ -1,0 +1,66 @@
+"""Which shape factor a view uses, in one phrase, and the design the views of every direction get.
+
+The one setting is the design's ``shape`` (the sidebar's *Finite-length shape factor* switch,
+:attr:`app.state.ExplorerState.finite_length`): ``finite``, the finite-length FE table in every
+direction; otherwise (None, or ``long`` from a file) the thesis' long-bushing formulas where they
+exist, axial (eq 18) and torsion (eq 17), and the finite-length table for radial and conical,
+which have none that holds at real lengths. Every view that draws a design says which it uses
+with :func:`shape_phrase`.
+"""
+
+from __future__ import annotations
+
+from core import Design
+from core.parameters import MODE, THESIS_MODES
+
+
+def card_basis(design: Design) -> Design:
+    """``design`` as the bushing card (:mod:`core.card`) and the exports (:mod:`core.io.export`)
+    must get it to use the explorer's setting in every direction: their convention is the
+    finite-length table unless the design's ``shape`` is ``long``, so a design on the long
+    setting says so explicitly (in a mode without a long form, taken into the first one that
+    has: the card uses the design's mode for a rig's apparent mass only, which goes with it)."""
+    if design.shape == "finite":
+        return design
+    if design.mode in THESIS_MODES:
+        return design if design.shape == "long" else design.replace(shape="long")
+    return design.in_mode(THESIS_MODES[0]).replace(shape="long")
+
+
+def shape_used(design: Design, mode: str | None = None) -> str:
+    """The shape factor ``design``'s setting gives direction ``mode`` (default: its own), in a
+    few words: "long-bushing formula (eq 18)" or "finite-length table"."""
+    mode = mode or design.mode
+    if design.shape != "finite" and mode in THESIS_MODES:  # the thesis' closed forms (docs/model.md)
+        return f"long-bushing formula (eq {MODE[mode].long_equation})"
+    return "finite-length table"
+
+
+def shape_phrase(design: Design, modes: tuple[str, ...] | None = None) -> str:
+    """The one sentence each view shows: "Shape factor: …" for ``design``'s own mode, or for
+    each of ``modes`` (those with the same kind of shape factor named together)."""
+    if modes is None:
+        return f"Shape factor: {shape_used(design)}."
+    long = [m for m in modes if shape_used(design, m) != "finite-length table"]
+    finite = [m for m in modes if m not in long]
+    if not long:
+        return "Shape factor: finite-length table, every direction."
+    plural = "s" if len(long) > 1 else ""
+    eqs = ", ".join(str(MODE[m].long_equation) for m in long)
+    parts = [f"{' and '.join(long)}, long-bushing formula{plural} (eq{plural} {eqs})"]
+    if finite:
+        parts.append(f"{' and '.join(finite)}, finite-length table")
+    return "Shape factor: " + "; ".join(parts) + "."
+
+
+def shape_note_html(design: Design, modes: tuple[str, ...] | None = None) -> str:
+    """:func:`shape_phrase` as the page shows it (class ``shape-phrase``)."""
+    return f'<span class="shape-phrase">{shape_phrase(design, modes)}</span>'
+
+
+def shape_pane(state, modes: tuple[str, ...] | None = None):
+    """A line that follows ``state.design``: :func:`shape_note_html` (a Panel pane)."""
+    import panel as pn
+
+    return pn.pane.HTML(pn.bind(lambda design: shape_note_html(design, modes), state.param.design),
+                        sizing_mode="stretch_width", margin=(0, 10), styles={"font-size": "0.9em"})
