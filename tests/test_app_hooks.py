@@ -18,7 +18,7 @@ def ranges(overlay):
 
 
 @pytest.mark.parametrize("view, plot", [("teaching", "real"), ("teaching", "loop"), ("slices", "magnitude"),
-                                        ("card", "translation")])
+                                        ("card", "radial")])
 def test_a_view_keeps_the_axes_of_what_it_drew_before(app, view, plot):
     """A tab redrawn for a very different design draws on new ranges; the overlay it showed before
     keeps its own (the Fletcher–Gent tab, the slices, the card)."""
@@ -90,4 +90,5 @@ def test_the_bokehjs_patches_go_into_a_page_once():
     patches.install(doc)
     patches.install(doc)
     callbacks = doc.callbacks._js_event_callbacks.get("document_ready", [])
-    assert [c.code for c in callbacks] == [patches.BOKEHJS_PAINT_PATCHES, patches.BOKEHJS_SERVER_MODELS]
+    assert [c.code for c in callbacks] == [patches.BOKEHJS_PAINT_PATCHES, patches.BOKEHJS_SERVER_MODELS,
+                                             patches.LABEL_CLICKS]
