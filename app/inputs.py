@@ -13,6 +13,7 @@ from core.parameters import DEFAULT_SHAPE
 
 from .curves import amplitude_bounds
 from .fields import DESIGN_FIELDS, GEOMETRY_FIELDS, MATERIAL_FIELDS
+from .number_field import NumberField, NumberText
 from .state import ExplorerState
 from .units import OPERATING_FREQUENCIES, amplitude_unit
 
@@ -30,7 +31,7 @@ class FloatSlider(pn.widgets.FloatSlider):
     """Panel's FloatSlider; served, without the debounce on its value (see :class:`FloatInput`)."""
 
 
-IMMEDIATE = (FloatInput, IntInput, FloatSlider)  # the app's number widgets, for app.patches
+IMMEDIATE = (FloatInput, IntInput, FloatSlider, NumberText)  # the app's number widgets, for app.patches
 
 
 class LogSlider(pn.viewable.Viewer):
@@ -118,18 +119,13 @@ class DesignInputs(pn.viewable.Viewer):
     def __init__(self, state: ExplorerState, **params):
         super().__init__(**params)
         self.state = state
-        self.widgets = {
-            name: FloatInput.from_param(
-                state.param[name], description=state.param[name].doc, step=DESIGN_FIELDS[name].step,
-                sizing_mode="stretch_width", label=state.param[name].label,
-            )
-            for name in DESIGN_FIELDS
+        self.fields = {
+            name: NumberField(state, name, label=state.param[name].label, quantity="parameter", blank=False,
+                              unit=DESIGN_FIELDS[name].unit.display if name in DESIGN_FIELDS else "Hz",
+                              sizing_mode="stretch_width")
+            for name in (*DESIGN_FIELDS, "freq_min", "freq_max")
         }
-        for name in ("freq_min", "freq_max"):
-            self.widgets[name] = FloatInput.from_param(
-                state.param[name], description=state.param[name].doc, step=1.0,
-                sizing_mode="stretch_width", label=state.param[name].label,
-            )
+        self.widgets = {name: field.input for name, field in self.fields.items()}
         self.preset = pn.widgets.Select.from_param(
             state.param.preset, description=state.param.preset.doc, sizing_mode="stretch_width",
         )
@@ -147,7 +143,9 @@ class DesignInputs(pn.viewable.Viewer):
         self.frequency = LogSlider(state, "frequency_hz", lambda: OPERATING_FREQUENCIES, lambda: "Hz")
 
     def _field(self, name):
-        return pn.Column(self.widgets[name], error_text(self.state, name), margin=0, sizing_mode="stretch_width")
+        field = self.fields[name]
+        return pn.Column(field.input, field.message, error_text(self.state, name), margin=0,
+                         sizing_mode="stretch_width")
 
     def _shape_note(self):
         """How far the finite-length shape factor is from the long-bushing formula, for this

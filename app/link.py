@@ -11,6 +11,7 @@ from urllib.parse import parse_qsl, urlencode
 import param
 from panel.util import parse_query
 
+from core.numbers import link_number
 from core.parameters import PARAMETERS
 
 from .state import ExplorerState
@@ -32,12 +33,19 @@ URL_DELAY_MS = 300
 
 
 def url_query(state: ExplorerState) -> dict[str, str]:
-    """The state's linked values as the link writes them, by URL name: text as it is, anything
-    else as JSON (``true``, ``2.42`` in the field's display unit, ``null`` for a blank field)."""
+    """The state's linked values as the link writes them, by URL name: text as it is, a number
+    in the field's display unit to :data:`core.numbers.LINK_DIGITS` significant digits
+    (:func:`core.numbers.link_number`: ``2.41046``, ``0.1``), anything else as JSON (``true``,
+    ``null`` for a blank field)."""
     out = {}
     for name, key in URL_NAMES.items():
         value = getattr(state, name)
-        out[key] = value if isinstance(value, str) else json.dumps(value)
+        if isinstance(value, str):
+            out[key] = value
+        elif isinstance(value, float):
+            out[key] = link_number(value)
+        else:
+            out[key] = json.dumps(value)
     return out
 
 
@@ -76,9 +84,12 @@ def apply_link(state: ExplorerState, values: dict):
 
 
 def _same(a, b) -> bool:
-    """Whether a link's value ``a`` is the state's ``b`` (False is no 0, "2" no 2)."""
+    """Whether a link's value ``a`` is the state's ``b`` (False is no 0, "2" no 2; numbers to the
+    link's digits: a state value with more digits than a link writes is not changed by its own link)."""
     if isinstance(a, str) or isinstance(b, str):
         return a == b
+    if isinstance(a, float) and isinstance(b, float):  # as the link writes them (its digits)
+        return link_number(a) == link_number(b)
     return isinstance(a, bool) == isinstance(b, bool) and a == b
 
 
