@@ -14,8 +14,8 @@ import param
 
 from core import PAPER_B, Design, DesignError, Geometry, Material
 from core.bushing import factors
+from core.numbers import range_problem, rounded
 from core.parameters import BY_NAME, GEOMETRY, MATERIAL, PARAMETERS, DesignParameter
-from core.numbers import LINK_DIGITS, range_problem, rounded
 from core.parts import MAX_MODULUS, SIZE_RANGE, STRAIN_HALF_RANGE, as_dict
 from core.rules import NOT_POSITIVE, ORDER_RANGE, OUT_OF_RANGE, OUTER_NOT_LARGER
 
@@ -30,10 +30,9 @@ _INNER, _OUTER, _LENGTH = BY_NAME["inner_radius"].field, BY_NAME["outer_radius"]
 
 
 def display_values(design: Design) -> dict[str, float]:
-    """The fields that show ``design``: display units, to the digits a link writes
-    (:data:`core.numbers.LINK_DIGITS`: no 19.200000000000003, no 2.41046111863 from a fit), so that
-    a shared link gives the same design."""
-    return {name: rounded(p.unit.to_display(design.value(p.name)), LINK_DIGITS) for name, p in DESIGN_FIELDS.items()}
+    """The fields' values for ``design`` (display units, to 12 digits: no 19.200000000000003; the
+    fields show them to their quantity's digits, a link writes :data:`core.numbers.LINK_DIGITS`)."""
+    return {name: rounded(p.unit.to_display(design.value(p.name)), 12) for name, p in DESIGN_FIELDS.items()}
 
 
 def _field(p: DesignParameter, default: float) -> param.Number:

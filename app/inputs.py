@@ -125,7 +125,7 @@ class DesignInputs(pn.viewable.Viewer):
                               sizing_mode="stretch_width")
             for name in (*DESIGN_FIELDS, "freq_min", "freq_max")
         }
-        self.widgets = {name: field.input for name, field in self.fields.items()}
+        self.widgets = self.fields  # kept name: a field's ``value`` is the state's
         self.preset = pn.widgets.Select.from_param(
             state.param.preset, description=state.param.preset.doc, sizing_mode="stretch_width",
         )

@@ -45,26 +45,38 @@ class NumberField(pn.viewable.Viewer):
         super().__init__()
         p = obj.param[name]
         self.obj, self.pname, self.quantity, self.low_open = obj, name, quantity, low_open
+        self._showing = False
         self._unit = unit if callable(unit) else (lambda: unit)
         self._label = label or p.label
         self.bounds = bounds if bounds is not None else (p.bounds or (None, None))
         self.integer = isinstance(p, param.Integer)
         self.blank = p.allow_None if blank is None else blank
-        self.input = NumberText(name=self.label(), value=self.shown(getattr(obj, name)),
+        self.input = NumberText(label=self.label(), value=self.shown(getattr(obj, name)),
                                 description=p.doc, css_classes=["number-field"], **widget)
         self.message = pn.pane.HTML("", margin=(0, 10, 4, 10), sizing_mode="stretch_width",
                                     styles={"color": "#b03a2e", "font-size": "0.9em"})
         self.input.param.watch(self._typed, "value")
         obj.param.watch(self._set_elsewhere, name)
 
+    @property
+    def value(self):
+        """The bound value (set: as a program sets it, not through the text's rule)."""
+        return getattr(self.obj, self.pname)
+
+    @value.setter
+    def value(self, value):
+        setattr(self.obj, self.pname, value)
+
     def label(self) -> str:
-        """The label with the field's unit: ``|K| target (kN/mm)``."""
+        """The label with the field's unit: ``|K| target (kN/mm)``; a label that ends in its unit
+        (``Shear modulus µ (MPa)``, ``µ ± %``) as it is."""
         unit = self._unit()
-        return f"{self._label} ({unit})" if unit and unit != "–" and f"({unit})" not in self._label else self._label
+        named = not unit or unit == "–" or self._label.endswith((f"({unit})", f" {unit}"))
+        return self._label if named else f"{self._label} ({unit})"
 
     def relabel(self):
         """Show the label again (its unit may have changed)."""
-        self.input.name = self.label()
+        self.input.label = self.label()
 
     def shown(self, value) -> str:
         return "" if value is None else (str(int(value)) if self.integer else format_number(value, self.quantity))
@@ -87,6 +99,8 @@ class NumberField(pn.viewable.Viewer):
         return (int(value) if self.integer else value), None
 
     def _typed(self, event):
+        if self._showing:
+            return  # the field shows a value set elsewhere: not typed
         value, wrong = self.problem(event.new)
         if wrong:
             kept = getattr(self.obj, self.pname)
@@ -101,7 +115,11 @@ class NumberField(pn.viewable.Viewer):
         """A value set elsewhere is shown (formatted), unless the text already gives it."""
         value, wrong = self.problem(self.input.value)
         if wrong or value != event.new:
-            self.input.value = self.shown(event.new)
+            self._showing = True
+            try:
+                self.input.value = self.shown(event.new)
+            finally:
+                self._showing = False
             self.message.object = ""
 
     def __panel__(self):

@@ -32,8 +32,10 @@ DIGITS = {
 DEFAULT_DIGITS = 4
 # magnitudes written positionally: from 0.0001 up to (not including) ten million
 PLAIN_LOW, PLAIN_HIGH = 1e-4, 1e7
-# the digits of a number in a link (more than any field shows: a link read back shows the same)
-LINK_DIGITS = 6
+# the digits of a number in a link: more than any field shows, and enough that the design a link
+# gives shows the same numbers as the design it was written from (a found design's |K| moves by
+# 1.3e-4 when its fields are rounded to 6 digits: the thin rubber layer amplifies)
+LINK_DIGITS = 9
 _SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 _FROM_SUPERSCRIPT = str.maketrans("⁻⁰¹²³⁴⁵⁶⁷⁸⁹", "-0123456789")
 
@@ -141,9 +143,9 @@ const plain = (v) => {
 };
 const v = Number(tick.toPrecision(digits));
 const a = Math.abs(v);
-if (a >= %(low)r && a < %(high)r) { return plain(v); }
+if (a >= PLAIN_LOW && a < PLAIN_HIGH) { return plain(v); }
 let e = 3 * Math.floor(Math.log10(a) / 3);
 let m = Number((v / Math.pow(10, e)).toPrecision(digits));
 if (Math.abs(m) >= 1000) { m = Number((m / 1000).toPrecision(digits)); e += 3; }
 return plain(m) + "×10" + String(e).split("").map((c) => sup[c]).join("");
-""" % {"low": PLAIN_LOW, "high": PLAIN_HIGH}
+""".replace("PLAIN_LOW", repr(PLAIN_LOW)).replace("PLAIN_HIGH", repr(PLAIN_HIGH))

@@ -15,8 +15,8 @@ from .. import units
 from ..bands import band_tolerances, banded
 from ..curves import card_bands, card_sweeps, padded
 from ..fit_state import FitState
-from ..inputs import FloatInput
 from ..live import LivePlot
+from ..number_field import NumberField
 from ..plotting.every_direction import card_dimensions, card_overlays
 from ..plotting.style import ranged
 from ..state import ExplorerState
@@ -49,8 +49,8 @@ class CardView(PlotView):
     def __init__(self, state: ExplorerState, fit: FitState, **params):
         super().__init__(state, fit=fit, **params)
         self.inputs = pn.Row(
-            FloatInput.from_param(self.param.displacement_mm, start=1e-6, end=100.0, step=0.01),
-            FloatInput.from_param(self.param.angle_rad, start=1e-7, end=1.0, step=0.001),
+            NumberField(self, "displacement_mm", unit=TRANSLATION.amplitude.display, quantity="amplitude"),
+            NumberField(self, "angle_rad", unit=ROTATION.amplitude.display, quantity="amplitude"),
             sizing_mode="stretch_width")
         self.table = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.dims = card_dimensions()
