@@ -8,6 +8,8 @@ import holoviews as hv
 import panel as pn
 import param
 
+from core.numbers import format_value
+
 from .. import curves, units
 from ..bands import band_tolerances, banded
 from ..fit_state import FitState
@@ -60,9 +62,9 @@ class ExplorerPlots(PlotView):
         point = curves.operating_point(design, f, x)
         amplitude_unit, stiffness_unit = units.amplitude_unit(design.mode), units.stiffness_unit(design.mode)
         self.summary.object = (
-            f'<span class="op-summary"><b>Operating point</b>: <span class="op-point">{x:.3g} '
-            f"{amplitude_unit}, {f:.3g} Hz</span> &nbsp;→&nbsp; |K| = "
-            f"<b>{point['magnitude']:.4g} {stiffness_unit}</b>, loss factor <b>{point['loss_factor']:.4f}</b></span>"
+            f'<span class="op-summary"><b>Operating point</b>: <span class="op-point">'
+            f"{format_value(x, amplitude_unit, 'amplitude')}, {format_value(f, 'Hz', 'frequency')}</span> &nbsp;→&nbsp; |K| = "
+            f"<b>{format_value(point['magnitude'], stiffness_unit, 'stiffness')}</b>, loss factor <b>{point['loss_factor']:.4f}</b></span>"
             + (f'<br><span class="band-summary">{band_words(data.bands["point"], stiffness_unit)}</span>'
                if data.bands else "")
             + (f'<br><span class="band-message" style="color:#8a5300">No tolerance band: {reason}</span>'

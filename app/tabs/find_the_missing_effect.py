@@ -13,6 +13,7 @@ import panel as pn
 from core.effects import EFFECTS
 from core.identify.diagnose import BIC_THRESHOLD
 from core.material import ConvergenceError
+from core.numbers import format_value
 
 from ..diagnosis_state import DiagnosisState
 from ..live import LivePlot, update_or_keep
@@ -41,6 +42,13 @@ PROGRESS_POLL_S = 0.15
 def _effect_card(eid: str) -> str:
     e = EFFECTS[eid]
     return f"**{e.title}** (`{eid}`). {e.physics} *Signature in data:* {e.signature}"
+
+
+
+def effect_units(effect: str, mode: str) -> dict[str, str]:
+    """The units of ``effect``'s fitted parameters in ``mode`` (by their names in a report, plain
+    or ``effect.name``), from the one table (:class:`core.parameters.Parameter`)."""
+    return {key: p.unit_in(mode) for p in EFFECTS[effect].parameters for key in (p.name, f"{effect}.{p.name}")}
 
 
 class DiagnosisView(pn.viewable.Viewer):
@@ -175,7 +183,8 @@ class DiagnosisView(pn.viewable.Viewer):
             f"*Where it disagrees:* {r.where_baseline}",
         ]
         for n, step in enumerate(r.steps, 1):
-            params = ", ".join(f"{k} = {v:.4g}" + (f" ± {step.standard_errors[k]:.2g}"
+            unit = effect_units(step.effect, r.baseline.model.design.mode)
+            params = ", ".join(f"{k} = {format_value(v, unit.get(k, ''))}" + (f" ± {format_value(step.standard_errors[k], unit.get(k, ''), 'error')}"
                                                    if np.isfinite(step.standard_errors.get(k, np.nan)) else
                                                    " (not determined)" if k in step.undetermined else "")
                                for k, v in step.parameters.items()) or "no parameters"
