@@ -95,8 +95,8 @@ PANEL_WORDS = {
 
 
 # the range (SI) of a parameter the core holds it in (core.parts), by parameter name
-SI_RANGES = {**{n: SIZE_RANGE for n in GEOMETRY}, "friction_strain_half": STRAIN_HALF_RANGE,
-             **{n: (0.0, MAX_MODULUS) for n in ("shear_modulus", "fractional_coefficient", "friction_stress_max")}}
+SI_RANGES = {**{n: SIZE_RANGE for n in GEOMETRY}, BY_NAME["friction_strain_half"].name: STRAIN_HALF_RANGE,
+             **{p.name: (0.0, MAX_MODULUS) for p in PARAMETERS if p.unit.si.startswith("Pa")}}
 
 
 def _plain(exc: DesignError, typed: float | None = None) -> str:
