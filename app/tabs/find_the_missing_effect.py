@@ -44,7 +44,6 @@ def _effect_card(eid: str) -> str:
     return f"**{e.title}** (`{eid}`). {e.physics} *Signature in data:* {e.signature}"
 
 
-
 def effect_units(effect: str, mode: str) -> dict[str, str]:
     """The units of ``effect``'s fitted parameters in ``mode`` (by their names in a report, plain
     or ``effect.name``), from the one table (:class:`core.parameters.Parameter`)."""
