@@ -16,7 +16,7 @@ import holoviews.plotting.bokeh
 import numpy as np
 from bokeh.models import CustomJSTickFormatter, SaveTool
 
-from core.numbers import TICK_JS
+from core.numbers import TICK_JS, format_value
 from core.parameters import MODES
 from core.parameters import mode as mode_of
 
@@ -30,7 +30,7 @@ SWEEP_PALETTES = {  # light to dark as the swept value grows
 
 
 def sweep_label(value, unit) -> str:
-    return f"{value:.3g} {unit}"
+    return format_value(value, unit, 3)
 
 
 BRANCH_COLORS = {"elastic": "#1f77b4", "viscoelastic": "#2ca02c", "friction": "#d62728"}

@@ -8,6 +8,7 @@ import panel as pn
 import param
 
 from core.card import card, card_design, ratios
+from core.numbers import format_number, format_value
 from core.parameters import MODE, ROTATIONS, TRANSLATIONS
 from core.shape import long_shape_factor
 
@@ -83,7 +84,7 @@ class CardView(PlotView):
     @staticmethod
     def summary(design, frequency_hz, rows) -> str:
         g = design.geometry
-        lines = [f"**At {frequency_hz:.3g} Hz** ({design.name or 'this design'})", "",
+        lines = [f"**At {format_value(frequency_hz, 'Hz', 'frequency')}** ({design.name or 'this design'})", "",
                  "| direction | amplitude | \\|K\\| | loss factor | shape factor S | S / long-bushing formula |",
                  "|---|---|---|---|---|---|"]
         for r in rows:
@@ -96,8 +97,8 @@ class CardView(PlotView):
             except ValueError:
                 versus = "no formula"
             used = card_design(design, mode).shape_kind
-            lines.append(f"| {mode} ({used}) | {amp:.3g} {units.amplitude_unit(mode)} | {k:.4g} "
-                         f"{units.stiffness_unit(mode)} | {r['loss_factor']:.4f} | {r['shape_factor']:.4g} {s_unit} "
+            lines.append(f"| {mode} ({used}) | {format_value(amp, units.amplitude_unit(mode), 'amplitude')} | {format_number(k, 'stiffness')} "
+                         f"{units.stiffness_unit(mode)} | {r['loss_factor']:.4f} | {format_value(r['shape_factor'], s_unit)} "
                          f"| {versus} |")
         q = ratios(design, rows)
         lines += ["", (f"**Ratios**: radial / axial **{q['radial/axial']:.2f}**; radial / torsion-equivalent "

@@ -8,7 +8,7 @@ import holoviews as hv
 import panel as pn
 import param
 
-from core.numbers import format_value
+from core.numbers import format_number, format_value
 
 from .. import curves, units
 from ..bands import band_tolerances, banded
@@ -80,7 +80,7 @@ def band_words(p: dict, unit: str) -> str:
     first-order check."""
     low, high = p["percentiles"]
     return (f"<b>Tolerance band</b> ({low:g}–{high:g} %, {p['samples']} {p['distribution']} samples, seed {p['seed']}): "
-            f"|K| {p['magnitude'][0]:.4g}–{p['magnitude'][1]:.4g} {unit}, loss factor "
+            f"|K| {format_number(p['magnitude'][0], 'stiffness')}–{format_value(p['magnitude'][1], unit, 'stiffness')}, loss factor "
             f"{p['loss_factor'][0]:.4f}–{p['loss_factor'][1]:.4f}. Spread (1σ) of |K| {p['std_magnitude_pct']:.2f} % "
             f"(first order {p['first_order_magnitude_pct']:.2f} %), of the loss factor {p['std_loss_factor']:.4f} "
             f"(first order {p['first_order_loss_factor']:.4f}).")
@@ -120,8 +120,8 @@ class CompareView(PlotView):
         unit = units.stiffness_unit(design.mode)
         (m_now, m_ref, m_d), (e_now, e_ref, e_d) = c["operating"]["magnitude"], c["operating"]["loss_factor"]
         return (
-            f"| at {f:.3g} Hz, {x:.3g} {units.amplitude_unit(design.mode)} | this design | reference | difference |\n|---|---|---|---|\n"
-            f"| \\|K\\| ({unit}) | {m_now:.4g} | {m_ref:.4g} | {pct(m_d)} |\n"
+            f"| at {format_value(f, 'Hz', 'frequency')}, {format_value(x, units.amplitude_unit(design.mode), 'amplitude')} | this design | reference | difference |\n|---|---|---|---|\n"
+            f"| \\|K\\| ({unit}) | {format_number(m_now, 'stiffness')} | {format_number(m_ref, 'stiffness')} | {pct(m_d)} |\n"
             f"| loss factor | {e_now:.4f} | {e_ref:.4f} | {pct(e_d)} |\n\n"
             f"Largest difference over the frequency sweep: \\|K\\| {pct(c['largest_over_frequency']['magnitude'])}, "
             f"loss factor {pct(c['largest_over_frequency']['loss_factor'])}; over the amplitude sweep: "

@@ -13,7 +13,7 @@ import panel as pn
 from core.effects import EFFECTS
 from core.identify.diagnose import BIC_THRESHOLD
 from core.material import ConvergenceError
-from core.numbers import format_value
+from core.numbers import format_number, format_value
 
 from ..diagnosis_state import DiagnosisState
 from ..live import LivePlot, update_or_keep
@@ -155,8 +155,8 @@ class DiagnosisView(pn.viewable.Viewer):
             modes = d.modes(s.explorer.design.mode).astype(str)
             per_mode = [f"{m} {int(np.sum(modes == m))} points at {np.unique(d.amplitude[modes == m]).size} "
                         f"amplitude(s)" for m in np.unique(modes)]
-            self.source.object = (f"**Data**: {s.source}: {len(d)} points, {d.frequency_hz.min():.3g}–"
-                                  f"{d.frequency_hz.max():.3g} Hz; {'; '.join(per_mode)}.")
+            self.source.object = (f"**Data**: {s.source}: {len(d)} points, {format_number(d.frequency_hz.min(), 'frequency')}–"
+                                  f"{format_value(d.frequency_hz.max(), 'Hz', 'frequency')}; {'; '.join(per_mode)}.")
         else:
             self.source.object = "_No data loaded yet._"
         self.run.disabled = s.running or s.data is None

@@ -134,16 +134,16 @@ class MeasuredView(PlotView):
             else:
                 shown = "" if d.mode is None else f" ({int((d.mode == s.design.mode).sum())} {s.design.mode} shown)"
                 lines.append(
-                    f"**Stiffness**: {len(d)} points{modes}{shown}, {d.frequency_hz.min():.3g}–"
-                    f"{d.frequency_hz.max():.3g} Hz, amplitudes {points['amplitude'].min():.3g}–"
-                    f"{points['amplitude'].max():.3g} {unit}; gap of the current design: "
+                    f"**Stiffness**: {len(d)} points{modes}{shown}, {format_number(d.frequency_hz.min(), 'frequency')}–"
+                    f"{format_value(d.frequency_hz.max(), 'Hz', 'frequency')}, amplitudes {format_number(points['amplitude'].min(), 'amplitude')}–"
+                    f"{format_value(points['amplitude'].max(), unit, 'amplitude')}; gap of the current design: "
                     f"**{residuals['gap']:.4f}**"
                     + (f" (drawn as {len(points['frequency_hz'])} bin means; fits bin them too)"
                        if len(points["frequency_hz"]) < len(d.of_mode(s.design.mode)) else ""))
         if s.measured_loop is not None:
             f, amp, _ = s.measured_loop.harmonic()
-            lines.append(f"**Loop**: {s.measured_loop.time_s.size} samples at {f:.3g} Hz, amplitude "
-                         f"{units.display_amplitude(amp, mode):.3g} {unit}")
+            lines.append(f"**Loop**: {s.measured_loop.time_s.size} samples at {format_value(f, 'Hz', 'frequency')}, amplitude "
+                         f"{format_value(units.display_amplitude(amp, mode), unit, 'amplitude')}")
         self.summary.object = "\n\n".join(lines) or "_No measured data loaded._"
         self._draw(points, residuals)
         options = {format_value(units.display_amplitude(a, mode), unit): a for a in measured_amplitudes(s.measured)}
