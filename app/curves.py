@@ -23,7 +23,7 @@ from core.bushing import (
 )
 from core.card import CARD_MODES, card_design
 from core.data import MeasuredLoop, MeasuredStiffness
-from core.identify.fit import folded, model_stiffness, selection
+from core.identify.fit import folded, model_stiffness
 from core.loops import loop
 from core.material import ConvergenceError
 from core.residuals import gap
@@ -477,9 +477,11 @@ def prediction_misfit(fit, measured: MeasuredStiffness | None) -> dict | None:
     misfit (model − measured, %) against frequency of the fitted rows and of the predicted ones."""
     if fit is None or not fit.prediction or measured is None:
         return None
-    chosen = selection(measured, fit.design.mode, fit.prediction["fit_on"])
-    pct = magnitude_residual_pct(model_stiffness(fit.design, measured), measured.stiffness)
     modes = measured.modes(fit.design.mode).astype(str)
+    chosen = np.zeros(len(measured), dtype=bool)  # the rows of the groups the fit used (whatever the spec's units)
+    for g in fit.prediction["groups"]:
+        chosen |= (modes == g["mode"]) & (measured.amplitude == g["amplitude"]) & g["fitted"]
+    pct = magnitude_residual_pct(model_stiffness(fit.design, measured), measured.stiffness)
     out = {}
     for mode in np.unique(modes):
         rows = modes == mode

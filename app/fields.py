@@ -14,9 +14,10 @@ import param
 
 from core import PAPER_B, Design, DesignError, Geometry, Material
 from core.bushing import factors
+from core.numbers import range_problem, rounded
 from core.parameters import BY_NAME, DEFAULT_SHAPE, GEOMETRY, MATERIAL, PARAMETERS, DesignParameter
-from core.parts import SIZE_RANGE, as_dict
-from core.rules import NOT_POSITIVE, ORDER_RANGE, OUTER_NOT_LARGER
+from core.parts import MAX_MODULUS, SIZE_RANGE, STRAIN_HALF_RANGE, as_dict
+from core.rules import NOT_POSITIVE, ORDER_RANGE, OUT_OF_RANGE, OUTER_NOT_LARGER
 from core.shape import OutsideTable, table
 
 # field name → its design parameter, in the table's order (geometry, then material)
@@ -30,8 +31,9 @@ _INNER, _OUTER, _LENGTH = BY_NAME["inner_radius"].field, BY_NAME["outer_radius"]
 
 
 def display_values(design: Design) -> dict[str, float]:
-    """The fields that show ``design`` (display units, to 12 digits: no 19.200000000000003)."""
-    return {name: float(f"{p.unit.to_display(design.value(p.name)):.12g}") for name, p in DESIGN_FIELDS.items()}
+    """The fields' values for ``design`` (display units, to 12 digits: no 19.200000000000003; the
+    fields show them to their quantity's digits, a link writes :data:`core.numbers.LINK_DIGITS`)."""
+    return {name: rounded(p.unit.to_display(design.value(p.name)), 12) for name, p in DESIGN_FIELDS.items()}
 
 
 def _field(p: DesignParameter, default: float) -> param.Number:
@@ -67,7 +69,7 @@ def design_from_fields(fields: Mapping, shown: Design, mode: str, shape: str | N
             elif not SIZE_RANGE[0] <= values[p.name] <= SIZE_RANGE[1]:  # this field alone
                 Geometry(**{**as_dict(shown.geometry), p.name: values[p.name]})
         except DesignError as exc:
-            errors[name] = _plain(exc)
+            errors[name] = _plain(exc, v)
     if _INNER not in errors and _OUTER not in errors:
         try:  # b > a, whatever else is wrong
             Geometry(values["inner_radius"], values["outer_radius"], shown.geometry.length)
@@ -130,12 +132,24 @@ PANEL_WORDS = {
 }
 
 
-def _plain(exc: DesignError) -> str:
+# the range (SI) of a parameter the core holds it in (core.parts), by parameter name
+SI_RANGES = {**{n: SIZE_RANGE for n in GEOMETRY}, BY_NAME["friction_strain_half"].name: STRAIN_HALF_RANGE,
+             **{p.name: (0.0, MAX_MODULUS) for p in PARAMETERS if p.unit.si.startswith("Pa")}}
+
+
+def _plain(exc: DesignError, typed: float | None = None) -> str:
     """A design error in the words of the input panel: by its rule code where the panel has its
-    own words, else the core's rule with the file's keys (``material.shear_modulus``) replaced by
-    the panel's names."""
+    own words; a value out of its range with the range in the field's display unit
+    (:func:`core.numbers.range_problem`); else the core's rule with the file's keys
+    (``material.shear_modulus``) replaced by the panel's names."""
     if exc.code in PANEL_WORDS:
         return PANEL_WORDS[exc.code]
+    p = BY_NAME.get(exc.key.partition(".")[2])
+    if exc.code == OUT_OF_RANGE and typed is not None and p is not None and p.name in SI_RANGES:
+        low, high = (float(p.unit.to_display(b)) for b in SI_RANGES[p.name])
+        wrong = range_problem(typed, low, high, p.unit.display, "parameter", low_open=low == 0.0)
+        if wrong:
+            return wrong[0].upper() + wrong[1:] + "."
     rule = exc.rule
     for name, key in ((p.field, p.name) for p in PARAMETERS):
         rule = rule.replace(f"geometry.{key}", name).replace(f"material.{key}", name)

@@ -12,9 +12,13 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
 import param
 
 from core.identify.fit import FitResult, fit_global, fit_two_step, predicted, selection
+from core.numbers import parse_number
+from core.parameters import MODE, MODE_TABLE
+from core.rules import RuleError
 
 from .state import ExplorerState, measured_amplitudes
 
@@ -42,7 +46,8 @@ class FitState(param.Parameterized):
                                    doc="The amplitude (SI) whose frequency sweep the two-step fit uses.")
     fit_on = param.String(default="", label="Fit on (the rest is predicted)",
                           doc="Empty: fit every row. Else mode=NAME[+NAME…] and/or amplitude=VALUE[+VALUE…] "
-                          "(SI), comma-separated, e.g. mode=axial,amplitude=1e-4: the fit uses those rows and "
+                          "in the tab's units (mm for axial and radial rows, rad for torsion and conical), "
+                          "comma-separated, e.g. mode=axial,amplitude=0.1: the fit uses those rows and "
                           "predicts the others, with the gap of each mode and amplitude.")
 
     def __init__(self, state: ExplorerState, **params):
@@ -75,7 +80,7 @@ class FitState(param.Parameterized):
         if not self.fit_on.strip() or s.measured is None:
             return fit_global(s.design, s.measured, s.measured_loop)
         spec = self.fit_on.strip()[:500]
-        chosen = selection(s.measured, s.design.mode, spec)
+        chosen = shown_selection(s.measured, s.design.mode, spec)
         result = fit_global(s.design, s.measured.select(chosen), s.measured_loop)
         return dataclasses.replace(result, prediction=predicted(result, s.measured, chosen, spec))
 
@@ -102,3 +107,34 @@ class FitState(param.Parameterized):
         """Take the fitted design into the explorer, keeping the operating point."""
         if self.fit_result is not None:
             self.state.adopt(self.fit_result.design)
+
+
+# the amplitudes' display units, in the words of a message: "mm (axial, radial) or rad (torsion, conical)"
+_AMPLITUDE_UNITS = " or ".join(
+    f"{u} ({', '.join(m.name for m in MODE_TABLE if m.amplitude.display == u)})"
+    for u in dict.fromkeys(m.amplitude.display for m in MODE_TABLE))
+
+
+def shown_selection(data, design_mode: str, spec: str) -> np.ndarray:
+    """The rows of ``data`` that *Fit on* chooses: as :func:`core.identify.fit.selection` (the
+    command line's ``--fit-on``, SI), but the amplitudes in the tab's display units, each row's
+    in its mode's (mm or rad), matched to the 4 digits the tab shows them with. ValueError on a
+    bad spec or an empty choice, in the tab's words."""
+    chosen = np.ones(len(data), dtype=bool)
+    modes = data.modes(design_mode).astype(str)
+    shown = np.asarray(data.amplitude, dtype=float) / np.array([MODE[m].amplitude.factor for m in modes])
+    for item in filter(None, (part.strip() for part in spec.split(","))):
+        key, _, value = item.partition("=")
+        if key.strip() != "amplitude":
+            chosen &= selection(data, design_mode, item)  # mode=…, and the words for a bad item
+            continue
+        try:
+            amps = [parse_number(v) for v in value.split("+") if v.strip()]
+        except RuleError as exc:
+            raise ValueError(f"Fit on: {item!r}: {exc.rule}; amplitudes are in {_AMPLITUDE_UNITS}") from None
+        if not amps:
+            raise ValueError(f"Fit on: {item!r}: give amplitude=VALUE[+VALUE…] in {_AMPLITUDE_UNITS}")
+        chosen &= np.any([np.isclose(shown, a, rtol=5e-4, atol=0) for a in amps], axis=0)
+    if not chosen.any():
+        raise ValueError(f"Fit on {spec!r} chooses none of the {len(data)} rows (amplitudes in {_AMPLITUDE_UNITS})")
+    return chosen

@@ -16,6 +16,7 @@ from core.rules import RuleError
 
 from .curves import amplitude_bounds
 from .fields import DESIGN_FIELDS, GEOMETRY_FIELDS, MATERIAL_FIELDS
+from .number_field import NumberField, NumberText
 from .state import PRESETS, ExplorerState
 from .units import OPERATING_FREQUENCIES, amplitude_unit
 from .uploads import design_dropper, on_upload
@@ -43,7 +44,7 @@ class FloatSlider(pn.widgets.FloatSlider):
     """Panel's FloatSlider; served, without the debounce on its value (see :class:`FloatInput`)."""
 
 
-IMMEDIATE = (FloatInput, IntInput, FloatSlider)  # the app's number widgets, for app.patches
+IMMEDIATE = (FloatInput, IntInput, FloatSlider, NumberText)  # the app's number widgets, for app.patches
 
 
 class LogSlider(pn.viewable.Viewer):
@@ -139,18 +140,13 @@ class DesignInputs(pn.viewable.Viewer):
     def __init__(self, state: ExplorerState, **params):
         super().__init__(**params)
         self.state = state
-        self.widgets = {
-            name: FloatInput.from_param(
-                state.param[name], description=state.param[name].doc, step=DESIGN_FIELDS[name].step,
-                sizing_mode="stretch_width", label=state.param[name].label,
-            )
-            for name in DESIGN_FIELDS
+        self.fields = {
+            name: NumberField(state, name, label=state.param[name].label, quantity="parameter", blank=False,
+                              unit=DESIGN_FIELDS[name].unit.display if name in DESIGN_FIELDS else "Hz",
+                              sizing_mode="stretch_width")
+            for name in (*DESIGN_FIELDS, "freq_min", "freq_max")
         }
-        for name in ("freq_min", "freq_max"):
-            self.widgets[name] = FloatInput.from_param(
-                state.param[name], description=state.param[name].doc, step=1.0,
-                sizing_mode="stretch_width", label=state.param[name].label,
-            )
+        self.widgets = self.fields  # kept name: a field's ``value`` is the state's
         self.preset = pn.widgets.Select(
             name=state.param.preset.label, options=[*PRESETS, CUSTOM], value=shown_preset(state.design),
             description=state.param.preset.doc + f" “{CUSTOM}”: the design is none of them.",
@@ -182,7 +178,9 @@ class DesignInputs(pn.viewable.Viewer):
             self.state.preset = event.new
 
     def _field(self, name):
-        return pn.Column(self.widgets[name], error_text(self.state, name), margin=0, sizing_mode="stretch_width")
+        field = self.fields[name]
+        return pn.Column(field.input, field.message, error_text(self.state, name), margin=0,
+                         sizing_mode="stretch_width")
 
     def _shape_note(self):
         """How far the finite-length shape factor is from the long-bushing formula, for this

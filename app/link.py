@@ -21,6 +21,7 @@ from panel.util import parse_query
 
 from core import PAPER_B, Design, DesignError
 from core.effects import validate_effects
+from core.numbers import link_number
 from core.parameters import PARAMETERS
 from core.rules import RuleError, decimal
 
@@ -49,12 +50,14 @@ URL_DELAY_MS = 300
 
 
 def url_value(value) -> str:
-    """A value as the link writes it: text as it is, anything else as JSON (``true``, ``2.42``
-    for a number, ``40`` for 40.0, ``null`` for none). The one place a link's numbers are
-    formatted: each reads back as the same float."""
-    if isinstance(value, float) and value.is_integer() and abs(value) < 1e15:
-        value = int(value)
-    return value if isinstance(value, str) else json.dumps(value)
+    """A value as the link writes it: text as it is, a number to :data:`core.numbers.LINK_DIGITS`
+    significant digits (:func:`core.numbers.link_number`: ``2.41046``, ``0.1``, ``40``), anything
+    else as JSON (``true``, ``null`` for none). The one place a link's values are formatted."""
+    if isinstance(value, str):
+        return value
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return link_number(value)
+    return json.dumps(value)
 
 
 # ---- a design in a link ------------------------------------------------------------------------
@@ -255,9 +258,12 @@ def _kept(state: ExplorerState, name: str) -> str:
 
 
 def _same(a, b) -> bool:
-    """Whether a link's value ``a`` is the state's ``b`` (False is no 0, "2" no 2)."""
+    """Whether a link's value ``a`` is the state's ``b`` (False is no 0, "2" no 2; numbers to the
+    link's digits: a state value with more digits than a link writes is not changed by its own link)."""
     if isinstance(a, str) or isinstance(b, str):
         return a == b
+    if isinstance(a, float) and isinstance(b, float):  # as the link writes them (its digits)
+        return link_number(a) == link_number(b)
     return isinstance(a, bool) == isinstance(b, bool) and a == b
 
 

@@ -11,6 +11,7 @@ import pytest
 
 from app.main import App
 from core import PAPER_B, stiffness, stiffness_points
+from core.numbers import format_value
 from core.synthetic import MYSTERIES, synthetic_stiffness
 from tests.helpers import element, xy
 
@@ -50,7 +51,8 @@ def test_a_diagnosis_in_the_tab_holds_the_core_numbers(app):
     r = state.result
     assert r.added == ["inertia"] and state.message == "" and not state.running
     assert "Step 1: add Apparent mass seen by the force sensor" in view.report.object
-    assert f"mass = {r.steps[0].parameters['mass']:.4g} ± {r.steps[0].standard_errors['mass']:.2g}" in view.report.object
+    mass, error = r.steps[0].parameters["mass"], r.steps[0].standard_errors["mass"]  # axial: kg
+    assert f"mass = {format_value(mass, 'kg')} ± {format_value(error, 'kg', 'error')}" in view.report.object
     assert "What is left is noise" in view.report.object
     # the gap bars: the baseline's and after each step; the noise line
     gap = view.live["gap"].current[0]

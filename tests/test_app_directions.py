@@ -11,6 +11,7 @@ from app.shapes import card_basis
 from core import PAPER_B, stiffness
 from core.bushing import shape_factor, strain_factor
 from core.card import card
+from core.numbers import format_number
 from tests.helpers import xy
 
 
@@ -68,7 +69,7 @@ def test_the_card_tab_holds_the_core_card(app):
     explorer_axial = stiffness(app.state.design, app.state.frequency_hz, 0.2e-3).magnitude[0, 0]
     assert rows[0]["mode"] == "axial" and rows[0]["magnitude"] == pytest.approx(explorer_axial, rel=1e-12)
     for r in rows:
-        assert f"{units.display_stiffness(r['magnitude'], r['mode']):.4g}" in view.table.object
+        assert format_number(units.display_stiffness(r['magnitude'], r['mode']), "stiffness") in view.table.object
     radial = next(r for r in rows if r["mode"] == "radial")["magnitude"]
     axial = next(r for r in rows if r["mode"] == "axial")["magnitude"]
     assert f"radial / axial **{radial / axial:.2f}**" in view.table.object

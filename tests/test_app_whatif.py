@@ -169,12 +169,13 @@ def test_no_number_field_of_any_tab_waits_before_it_sends_its_value(app):
     import panel as pn
 
     from app import patches
+    from app.number_field import NumberText
 
     patches.install()  # as create_app does for every session
     for name in ("slices", "teaching", "card", "measured", "diagnosis", "whatif"):
         app.view(name)
     numbers = (pn.widgets.FloatInput, pn.widgets.IntInput, pn.widgets.FloatSlider, pn.widgets.IntSlider,
-               pn.widgets.EditableFloatSlider)
+               pn.widgets.EditableFloatSlider, NumberText)
     found = [w for w in app.__panel__().select(pn.widgets.Widget) if isinstance(w, numbers)]
     assert len(found) > 20  # the design's fields, the tolerances, the targets, the card's drive …
     late = [f"{type(w).__name__} {w.name!r}" for w in found if "value" not in type(w)._priority_changes]

@@ -17,6 +17,7 @@ from core.identify.uncertainty import SIDE_EVALUATIONS, minimise, profile
 from core.io.design_file import read_design
 from core.io.measured import read_stiffness
 from core.io.targets import problem_from_dict
+from core.numbers import format_number
 from core.registry import parameter_unit
 from core.synthetic import synthetic_stiffness
 from core.whatif import target as target_module
@@ -215,5 +216,5 @@ def test_the_diagnosis_words_a_mass_in_its_modes_unit(design, unit):
     low, high = result.final.fit.intervals["inertia.mass"]
     assert low is None
     text = summary(result)
-    assert f"inertia.mass is not determined by these data: any value up to {high:.3g} {unit} fits" in text
+    assert f"inertia.mass is not determined by these data: any value up to {format_number(high, 3)} {unit} fits" in text
     assert "kg/" not in text

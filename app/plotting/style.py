@@ -14,9 +14,10 @@ import functools
 import holoviews as hv
 import holoviews.plotting.bokeh
 import numpy as np
-from bokeh.models import SaveTool
+from bokeh.models import CustomJSTickFormatter, SaveTool
 from holoviews.core.util import dimension_sanitizer
 
+from core.numbers import TICK_JS, format_value
 from core.parameters import MODES
 from core.parameters import mode as mode_of
 
@@ -30,7 +31,7 @@ SWEEP_PALETTES = {  # light to dark as the swept value grows
 
 
 def sweep_label(value, unit) -> str:
-    return f"{value:.3g} {unit}"
+    return format_value(value, unit, 3)
 
 
 BRANCH_COLORS = {"elastic": "#1f77b4", "viscoelastic": "#2ca02c", "friction": "#d62728"}
@@ -123,6 +124,17 @@ def canvas(plot, _element):
     which would change every plot of a notebook that imports the plotting API."""
     if plot.state.output_backend != "canvas":
         plot.state.output_backend = "canvas"
+
+
+def ticks(plot, _element):
+    """A hook writing every numeric axis' tick labels by the one number rule
+    (:data:`core.numbers.TICK_JS`: ``0.00015``, ``15×10⁻⁶``, never ``1.500e-4``), once per axis:
+    a formatter of its own per plot (a Bokeh model belongs to one document)."""
+    fig = plot.state
+    for axis in (*fig.xaxis, *fig.yaxis):
+        if not isinstance(axis.formatter, CustomJSTickFormatter) and hasattr(axis, "ticker") and \
+                type(axis).__name__ in ("LinearAxis", "LogAxis"):
+            axis.formatter = CustomJSTickFormatter(code=TICK_JS)
 
 
 @functools.cache
@@ -225,7 +237,7 @@ def scatter(x, y, xdim, ydim, label, **style):
 def overlay(items, title, png, *, logx=False, logy=False, legend="right", height=300):
     legend_opts = {"click_policy": "mute", "label_text_font_size": "11px", "spacing": 0, "padding": 4,
                    "margin": 4}
-    hooks = [canvas, png_name(png)] + ([legend_outside] if legend == "right" else [])
+    hooks = [canvas, ticks, png_name(png)] + ([legend_outside] if legend == "right" else [])
     options = {"title": title, "responsive": True, "height": height, "logx": logx, "logy": logy,
                "framewise": True, "hooks": hooks, "legend_opts": legend_opts,
                "fontsize": {"title": "13px"}, "show_legend": legend is not None}

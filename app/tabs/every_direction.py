@@ -8,6 +8,7 @@ import panel as pn
 import param
 
 from core.card import CARD_MODES, card, ratios
+from core.numbers import format_number, format_value
 from core.parameters import MODE, ROTATIONS, TRANSLATIONS
 from core.shape import long_shape_factor
 
@@ -15,8 +16,8 @@ from .. import units
 from ..bands import band_tolerances, banded
 from ..curves import card_bands, card_sweeps, padded
 from ..fit_state import FitState
-from ..inputs import FloatInput
 from ..live import LivePlot
+from ..number_field import NumberField
 from ..plotting.every_direction import card_dimensions, card_overlays
 from ..plotting.style import ranged
 from ..shapes import card_basis, shape_pane, shape_used
@@ -53,8 +54,8 @@ class CardView(PlotView):
     def __init__(self, state: ExplorerState, fit: FitState, **params):
         super().__init__(state, fit=fit, **params)
         self.inputs = pn.Row(
-            FloatInput.from_param(self.param.displacement_mm, start=1e-6, end=100.0, step=0.01),
-            FloatInput.from_param(self.param.angle_rad, start=1e-7, end=1.0, step=0.001),
+            NumberField(self, "displacement_mm", unit=TRANSLATION.amplitude.display, quantity="amplitude"),
+            NumberField(self, "angle_rad", unit=ROTATION.amplitude.display, quantity="amplitude"),
             sizing_mode="stretch_width")
         self.table = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.dims = card_dimensions()
@@ -93,7 +94,7 @@ class CardView(PlotView):
     @staticmethod
     def summary(design, frequency_hz, rows) -> str:
         g = design.geometry
-        lines = [f"**At {frequency_hz:.3g} Hz** ({design.name or 'this design'})", "",
+        lines = [f"**At {format_value(frequency_hz, 'Hz', 'frequency')}** ({design.name or 'this design'})", "",
                  ("| direction | amplitude | \\|K\\| | loss factor | shape factor used | S "
                  "| S / long-bushing formula |"),
                  "|---|---|---|---|---|---|---|"]
@@ -106,9 +107,9 @@ class CardView(PlotView):
                 versus = f"{r['shape_factor'] / long_shape_factor(g.inner_radius, g.outer_radius, g.length, mode):.3f}"
             except ValueError:
                 versus = "no formula"
-            lines.append(f"| {mode} | {amp:.3g} {units.amplitude_unit(mode)} | {k:.4g} "
-                         f"{units.stiffness_unit(mode)} | {r['loss_factor']:.4f} | {shape_used(design, mode)} "
-                         f"| {r['shape_factor']:.4g} {s_unit} | {versus} |")
+            lines.append(f"| {mode} | {format_value(amp, units.amplitude_unit(mode), 'amplitude')} "
+                         f"| {format_number(k, 'stiffness')} {units.stiffness_unit(mode)} | {r['loss_factor']:.4f} "
+                         f"| {shape_used(design, mode)} | {format_value(r['shape_factor'], s_unit)} | {versus} |")
         q = ratios(design, rows)
         lines += ["", (f"**Ratios**: radial / axial **{q['radial/axial']:.2f}**; radial / torsion-equivalent "
                        f"(K_torsion / r_m², r_m = (a + b)/2) **{q['radial/torsion-equivalent']:.2f}**.")]

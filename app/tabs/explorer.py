@@ -8,6 +8,8 @@ import holoviews as hv
 import panel as pn
 import param
 
+from core.numbers import format_number, format_value
+
 from .. import curves, units
 from ..bands import band_tolerances, banded
 from ..fit_state import FitState
@@ -61,9 +63,9 @@ class ExplorerPlots(PlotView):
         point = curves.operating_point(design, f, x)
         amplitude_unit, stiffness_unit = units.amplitude_unit(design.mode), units.stiffness_unit(design.mode)
         self.summary.object = (
-            f'<span class="op-summary"><b>Operating point</b>: <span class="op-point">{x:.3g} '
-            f"{amplitude_unit}, {f:.3g} Hz</span> &nbsp;→&nbsp; |K| = "
-            f"<b>{point['magnitude']:.4g} {stiffness_unit}</b>, loss factor <b>{point['loss_factor']:.4f}</b></span>"
+            f'<span class="op-summary"><b>Operating point</b>: <span class="op-point">'
+            f"{format_value(x, amplitude_unit, 'amplitude')}, {format_value(f, 'Hz', 'frequency')}</span> &nbsp;→&nbsp; |K| = "
+            f"<b>{format_value(point['magnitude'], stiffness_unit, 'stiffness')}</b>, loss factor <b>{point['loss_factor']:.4f}</b></span>"
             + (f'<br><span class="band-summary">{band_words(data.bands["point"], stiffness_unit)}</span>'
                if data.bands else "")
             + (f'<br><span class="band-message" style="color:#8a5300">No tolerance band: {reason}</span>'
@@ -79,7 +81,7 @@ def band_words(p: dict, unit: str) -> str:
     first-order check."""
     low, high = p["percentiles"]
     return (f"<b>Tolerance band</b> ({low:g}–{high:g} %, {p['samples']} {p['distribution']} samples, seed {p['seed']}): "
-            f"|K| {p['magnitude'][0]:.4g}–{p['magnitude'][1]:.4g} {unit}, loss factor "
+            f"|K| {format_number(p['magnitude'][0], 'stiffness')}–{format_value(p['magnitude'][1], unit, 'stiffness')}, loss factor "
             f"{p['loss_factor'][0]:.4f}–{p['loss_factor'][1]:.4f}. Spread (1σ) of |K| {p['std_magnitude_pct']:.2f} % "
             f"(first order {p['first_order_magnitude_pct']:.2f} %), of the loss factor {p['std_loss_factor']:.4f} "
             f"(first order {p['first_order_loss_factor']:.4f}).")
@@ -119,8 +121,8 @@ class CompareView(PlotView):
         unit = units.stiffness_unit(design.mode)
         (m_now, m_ref, m_d), (e_now, e_ref, e_d) = c["operating"]["magnitude"], c["operating"]["loss_factor"]
         return (
-            f"| at {f:.3g} Hz, {x:.3g} {units.amplitude_unit(design.mode)} | this design | reference | difference |\n|---|---|---|---|\n"
-            f"| \\|K\\| ({unit}) | {m_now:.4g} | {m_ref:.4g} | {pct(m_d)} |\n"
+            f"| at {format_value(f, 'Hz', 'frequency')}, {format_value(x, units.amplitude_unit(design.mode), 'amplitude')} | this design | reference | difference |\n|---|---|---|---|\n"
+            f"| \\|K\\| ({unit}) | {format_number(m_now, 'stiffness')} | {format_number(m_ref, 'stiffness')} | {pct(m_d)} |\n"
             f"| loss factor | {e_now:.4f} | {e_ref:.4f} | {pct(e_d)} |\n\n"
             f"Largest difference over the frequency sweep: \\|K\\| {pct(c['largest_over_frequency']['magnitude'])}, "
             f"loss factor {pct(c['largest_over_frequency']['loss_factor'])}; over the amplitude sweep: "

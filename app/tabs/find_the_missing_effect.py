@@ -13,6 +13,7 @@ from core.card import CARD_MODES
 from core.effects import EFFECTS, effect_title
 from core.identify.diagnose import BIC_THRESHOLD
 from core.material import ConvergenceError
+from core.numbers import format_number, format_value
 
 from ..diagnosis_state import DiagnosisState
 from ..inputs import tip
@@ -42,6 +43,12 @@ repeats until what is left is noise, or says what remains unexplained.
 def _effect_card(eid: str) -> str:
     e = EFFECTS[eid]
     return f"**{e.title}** (`{eid}`). {e.physics} *Signature in data:* {e.signature}"
+
+
+def effect_units(effect: str, mode: str) -> dict[str, str]:
+    """The units of ``effect``'s fitted parameters in ``mode`` (by their names in a report, plain
+    or ``effect.name``), from the one table (:class:`core.parameters.Parameter`)."""
+    return {key: p.unit_in(mode) for p in EFFECTS[effect].parameters for key in (p.name, f"{effect}.{p.name}")}
 
 
 class DiagnosisView(pn.viewable.Viewer):
@@ -150,8 +157,8 @@ class DiagnosisView(pn.viewable.Viewer):
             modes = d.modes(s.explorer.design.mode).astype(str)
             per_mode = [f"{m} {int(np.sum(modes == m))} points at {np.unique(d.amplitude[modes == m]).size} "
                         f"amplitude(s)" for m in np.unique(modes)]
-            self.source.object = (f"**Data**: {s.source}: {len(d)} points, {d.frequency_hz.min():.3g}–"
-                                  f"{d.frequency_hz.max():.3g} Hz; {'; '.join(per_mode)}.")
+            self.source.object = (f"**Data**: {s.source}: {len(d)} points, {format_number(d.frequency_hz.min(), 'frequency')}–"
+                                  f"{format_value(d.frequency_hz.max(), 'Hz', 'frequency')}; {'; '.join(per_mode)}.")
         else:
             self.source.object = "_No data loaded yet._"
         self.run.disabled = s.running or s.data is None
@@ -177,7 +184,8 @@ class DiagnosisView(pn.viewable.Viewer):
             f"*Where it disagrees:* {r.where_baseline}",
         ]
         for n, step in enumerate(r.steps, 1):
-            params = ", ".join(f"{k} = {v:.4g}" + (f" ± {step.standard_errors[k]:.2g}"
+            unit = effect_units(step.effect, r.baseline.model.design.mode)
+            params = ", ".join(f"{k} = {format_value(v, unit.get(k, ''))}" + (f" ± {format_value(step.standard_errors[k], unit.get(k, ''), 'error')}"
                                                    if np.isfinite(step.standard_errors.get(k, np.nan)) else
                                                    " (not determined)" if k in step.undetermined else "")
                                for k, v in step.parameters.items()) or "no parameters"

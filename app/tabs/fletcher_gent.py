@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 import panel as pn
 
+from core.numbers import format_number, format_value
+
 from ..curves import amplitude_bounds, amplitude_grid, branch_breakdown, hysteresis_loop, padded
 from ..live import LivePlot, update_or_keep
 from ..plotting.fletcher_gent import branch_overlays, loop_shape_overlay
@@ -95,8 +97,9 @@ class TeachingView(PlotView):
         shape = loop_shape_overlay(hysteresis_loop(s.design, s.frequency_hz, x), self.dims)
         self.loop = LivePlot.shown(self.loop, [shape])
         where = " (the operating amplitude)" if self.player.value == at else ""
-        self.frame_label.object = (f'<span class="frame-point">Loop shape at <b>{x:.3g} '
-                                   f"{amplitude_unit(s.design.mode)}</b>{where}, {s.frequency_hz:.3g} Hz</span>")
+        self.frame_label.object = (f'<span class="frame-point">Loop shape at <b>{format_number(x, "amplitude")} '
+                                   f"{amplitude_unit(s.design.mode)}</b>{where}, "
+                                   f"{format_value(s.frequency_hz, 'Hz', 'frequency')}</span>")
 
     def __panel__(self):
         return pn.Column(

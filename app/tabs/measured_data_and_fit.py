@@ -13,6 +13,7 @@ import panel as pn
 import param
 
 from core import PAPER_B
+from core.numbers import format_number, format_value
 from core.parameters import BY_NAME, MATERIAL
 from core.synthetic import paper_b_example
 
@@ -60,7 +61,7 @@ class MeasuredView(PlotView):
         self.fit_button.on_click(self._fit)
         self.method = pn.widgets.RadioButtonGroup.from_param(fit.param.fit_method, description=fit.param.fit_method.doc)
         self.fit_on = pn.widgets.TextInput.from_param(fit.param.fit_on, description=fit.param.fit_on.doc,
-                                                      placeholder="mode=axial,amplitude=1e-4", max_length=500,
+                                                      placeholder="mode=axial,amplitude=0.1", max_length=500,
                                                       sizing_mode="stretch_width")
         self.sweep = pn.widgets.Select(label="Sweep amplitude (two-step)", options={}, sizing_mode="stretch_width",
                                        description=fit.param.sweep_amplitude.doc)
@@ -135,19 +136,19 @@ class MeasuredView(PlotView):
             else:
                 shown = "" if d.mode is None else f" ({int((d.mode == s.design.mode).sum())} {s.design.mode} shown)"
                 lines.append(
-                    f"**Stiffness**: {len(d)} points{modes}{shown}, {d.frequency_hz.min():.3g}–"
-                    f"{d.frequency_hz.max():.3g} Hz, amplitudes {points['amplitude'].min():.3g}–"
-                    f"{points['amplitude'].max():.3g} {unit}; gap of the current design: "
+                    f"**Stiffness**: {len(d)} points{modes}{shown}, {format_number(d.frequency_hz.min(), 'frequency')}–"
+                    f"{format_value(d.frequency_hz.max(), 'Hz', 'frequency')}, amplitudes {format_number(points['amplitude'].min(), 'amplitude')}–"
+                    f"{format_value(points['amplitude'].max(), unit, 'amplitude')}; gap of the current design: "
                     f"**{residuals['gap']:.4f}**"
                     + (f" (drawn as {len(points['frequency_hz'])} bin means; fits bin them too)"
                        if len(points["frequency_hz"]) < len(d.of_mode(s.design.mode)) else ""))
         if s.measured_loop is not None:
             f, amp, _ = s.measured_loop.harmonic()
-            lines.append(f"**Loop**: {s.measured_loop.time_s.size} samples at {f:.3g} Hz, amplitude "
-                         f"{units.display_amplitude(amp, mode):.3g} {unit}")
+            lines.append(f"**Loop**: {s.measured_loop.time_s.size} samples at {format_value(f, 'Hz', 'frequency')}, amplitude "
+                         f"{format_value(units.display_amplitude(amp, mode), unit, 'amplitude')}")
         self.summary.object = "\n\n".join(lines) or "_No measured data loaded._"
         self._draw(points, residuals)
-        options = {f"{units.display_amplitude(a, mode):.4g} {unit}": a for a in measured_amplitudes(s.measured)}
+        options = {format_value(units.display_amplitude(a, mode), unit): a for a in measured_amplitudes(s.measured)}
         if options != self.sweep.options:
             self.sweep.options = options
         self.sweep.visible = self.fit.fit_method == "two-step"
@@ -171,10 +172,10 @@ class MeasuredView(PlotView):
         for p in MATERIAL:
             unit = BY_NAME[p].unit
             value, err = unit.to_display(getattr(r.design.material, p)), unit.to_display(r.standard_errors[p])
-            err = "–" if p in vague or not np.isfinite(err) else f"{err:.2g}"
-            ends = ["not bounded" if e is None else f"{unit.to_display(e):.3g}" for e in r.intervals.get(p, ())]
+            err = "–" if p in vague or not np.isfinite(err) else format_number(err, "error")
+            ends = ["not bounded" if e is None else format_number(unit.to_display(e), 3) for e in r.intervals.get(p, ())]
             interval = " – ".join(ends) + (" **not determined**" if p in vague else "") or "–"
-            rows.append(f"| {BY_NAME[p].symbol} ({unit.display}) | {value:.5g} | {err} | {interval} |")
+            rows.append(f"| {BY_NAME[p].symbol} ({unit.display}) | {format_number(value, 'parameter')} | {err} | {interval} |")
         gap = f"{r.gap:.4f}" if np.isfinite(r.gap) else "–"
         loop = f", loop RMS misfit {r.loop_rms:.4f}" if r.loop_rms is not None else ""
         corr = ["| | " + " | ".join(BY_NAME[p].symbol for p in MATERIAL) + " |",
@@ -190,7 +191,7 @@ class MeasuredView(PlotView):
             held = f"; the rows left out are predicted with a gap of **{p['gap_held_out']:.4f}**" if "gap_held_out" in p else ""
             prediction = (f"\n\n**Fitted on {p['fit_on']}** ({p['points_fitted']} points){held}:\n\n"
                           "| mode | amplitude | points | fitted | gap |\n|---|---|---|---|---|\n"
-                          + "\n".join(f"| {g['mode']} | {g['amplitude']:.3g} | {g['points']} | "
+                          + "\n".join(f"| {g['mode']} | {format_value(units.display_amplitude(g['amplitude'], g['mode']), units.amplitude_unit(g['mode']), 'amplitude')} | {g['points']} | "
                                       f"{'yes' if g['fitted'] else 'predicted'} | {g['gap']:.4f} |" for g in p["groups"]))
         return (f"### Fitted ({r.method})\n\nGap (relative RMS misfit of complex stiffness): **{gap}**{loop}; "
                 f"{r.points} points, {r.starts} starts.{by_mode}{prediction}{warnings}\n\n" + "\n".join(rows)

@@ -10,15 +10,17 @@ import panel as pn
 import param
 
 from core.card import CARD_MODES
-from core.parameters import BY_NAME, GEOMETRY, NAMES
+from core.numbers import format_number, format_value
+from core.parameters import BY_NAME, GEOMETRY, MODE, NAMES
 from core.whatif.sensitivity import elasticities, sentence
 from core.whatif.tolerance import ToleranceError
 
 from .. import curves, units
 from ..bands import band_tolerances, banded, tolerance_refusal
 from ..fit_state import FitState
-from ..inputs import FIELD_ERROR_STYLES, FloatInput, IntInput, field_error_html
+from ..inputs import FIELD_ERROR_STYLES, field_error_html
 from ..live import LivePlot, one_change
+from ..number_field import NumberField
 from ..plotting.what_ifs import sensitivity_bars
 from ..shapes import card_basis, shape_pane
 from ..state import ExplorerState
@@ -26,8 +28,8 @@ from ..targets_form import TargetsForm
 from ..views import PlotView
 
 A, _B, L, MU = (BY_NAME[n] for n in (*GEOMETRY, "shear_modulus"))
-# a found design's columns: its geometry and µ (what a search changes), each to its digits
-FOUND_COLUMNS = {**{n: ".3f" for n in GEOMETRY}, L.name: ".2f", MU.name: ".4g"}
+# a found design's columns: its geometry and µ (what a search changes), each with its quantity's digits
+FOUND_COLUMNS = {**{n: "size" for n in GEOMETRY}, MU.name: "modulus"}
 
 
 TOLERANCE_TEXT = """
@@ -53,6 +55,12 @@ the targets file to repeat it there.
 """
 
 
+# the tolerances' fields (± %, from 0 to 89 as a link's are: app.bands.parse_tolerances)
+ToleranceFields = type("ToleranceFields", (param.Parameterized,), {
+    "__doc__": "Each design parameter's tolerance, ± %.",
+    **{n: param.Number(0.0, bounds=(0.0, 89.0), label=f"{BY_NAME[n].label} ± %") for n in NAMES}})
+
+
 class WhatIfView(PlotView):
     """Tolerances, sensitivities, targets."""
 
@@ -63,12 +71,10 @@ class WhatIfView(PlotView):
     def __init__(self, state: ExplorerState, fit: FitState, **params):
         self._showing = False
         super().__init__(state, fit=fit, **params)
-        self.tolerance_inputs = {
-            n: FloatInput(label=f"{BY_NAME[n].label} ± %", value=self._shown_tolerances().get(n, 0.0), start=0.0,
-                                     end=89.0, step=0.5, width=170)
-            for n in NAMES}
-        for name, widget in self.tolerance_inputs.items():
-            widget.param.watch(lambda e, n=name: self._set_tolerance(n, e.new), "value")
+        self.tolerances = ToleranceFields(**self._shown_tolerances())
+        self.tolerance_inputs = {n: NumberField(self.tolerances, n, unit="%", quantity="percent", width=170)
+                                 for n in NAMES}
+        self.tolerances.param.watch(lambda *events: self._set_tolerance(events[-1].name, events[-1].new), list(NAMES))
         # beside each tolerance: why the design cannot take it (app.bands.tolerance_refusal)
         self.tolerance_errors = {n: pn.pane.HTML("", margin=(0, 10, 4, 10), styles=FIELD_ERROR_STYLES,
                                                  sizing_mode="stretch_width") for n in NAMES}
@@ -78,8 +84,8 @@ class WhatIfView(PlotView):
         self.band_controls = pn.FlexBox(
             pn.widgets.Checkbox.from_param(s.band_on, margin=(28, 10), width=330, css_classes=["band-switch"]),
             pn.widgets.Select.from_param(s.band_distribution, width=120),
-            IntInput.from_param(s.band_samples, width=100),
-            IntInput.from_param(s.band_seed, width=100),
+            NumberField(state, "band_samples", width=100),
+            NumberField(state, "band_seed", width=100),
             pn.widgets.Checkbox.from_param(s.band_from_fit, margin=(28, 10)),
             align_items="flex-start", sizing_mode="stretch_width")
         self.band_status = pn.pane.HTML("", sizing_mode="stretch_width")
@@ -87,6 +93,7 @@ class WhatIfView(PlotView):
         self.bars: LivePlot | None = None
         self.form = TargetsForm(state)
         self.form.param.watch(self._show_search, ["found", "message", "running", "progress_message"])
+        self.form_fields = self._form_fields()
         self.find = pn.widgets.Button(label="Find designs", color="primary", width=160)
         self.find.on_click(self._run)
         self.searching = pn.pane.HTML("", css_classes=["search-progress"], margin=(0, 10))
@@ -97,6 +104,23 @@ class WhatIfView(PlotView):
         self.targets_file = pn.widgets.FileDownload(callback=self._targets_file, filename="bushing-targets.json",
                                                     label="Targets file (JSON)", width=200)
         self.draw()
+
+    def _form_fields(self) -> dict[str, NumberField]:
+        """The design form's typed fields, each with its unit (the |K| target's follows the mode)."""
+        form, mode = self.form, lambda: self.state.design.mode
+        units_of = {"target_magnitude": lambda: units.stiffness_unit(mode()), "target_tolerance_pct": "%",
+                    "b_max_mm": _B.unit.display, "length_max_mm": L.unit.display,
+                    "thickness_min_mm": _B.unit.display, "mu_min_mpa": MU.unit.display,
+                    "mu_max_mpa": MU.unit.display}
+        quantity = {"target_magnitude": "stiffness", "target_tolerance_pct": "percent", "loss_factor_min": "loss_factor",
+                    "ratio_min": "ratio"}
+        widths = {"target_tolerance_pct": 120, "thickness_min_mm": 170}
+        fields = {n: NumberField(form, n, unit=units_of.get(n, ""), quantity=quantity.get(n, "size"),
+                                 low_open=n not in ("target_tolerance_pct", "loss_factor_min", "thickness_min_mm"), width=widths.get(n, 150))
+                  for n in ("target_magnitude", "target_tolerance_pct", "loss_factor_min", "ratio_min", "b_max_mm",
+                            "length_max_mm", "thickness_min_mm", "mu_min_mpa", "mu_max_mpa")}
+        self.state.param.watch(lambda _e: fields["target_magnitude"].relabel(), "design")
+        return fields
 
     # ---- tolerances ------------------------------------------------------------------------------
 
@@ -109,7 +133,7 @@ class WhatIfView(PlotView):
     def _set_tolerance(self, name: str, value):
         if self._showing:
             return
-        values = {n: w.value or 0.0 for n, w in self.tolerance_inputs.items()}
+        values = {n: getattr(self.tolerances, n) or 0.0 for n in NAMES}
         values[name] = float(value or 0.0)
         self.state.tolerance_pct = values
 
@@ -119,8 +143,7 @@ class WhatIfView(PlotView):
         values = self._shown_tolerances()
         self._showing = True  # the inputs follow the state here, not the other way round
         try:
-            for name, widget in self.tolerance_inputs.items():
-                widget.value = values.get(name, 0.0)
+            self.tolerances.param.update({n: values.get(n, 0.0) for n in NAMES})
         finally:
             self._showing = False
 
@@ -173,7 +196,8 @@ class WhatIfView(PlotView):
             items.append(sensitivity_bars(bars, title, color, f"bushing-sensitivity-{quantity.replace('_', '-')}"))
         self.bars = LivePlot.shown(self.bars, items)
         s = self.state
-        self.sentence.object = (f"At {s.frequency_hz:.3g} Hz and {s.amplitude:.3g} {units.amplitude_unit(s.design.mode)}: "
+        self.sentence.object = (f"At {format_value(s.frequency_hz, 'Hz', 'frequency')} and "
+                                f"{format_value(s.amplitude, units.amplitude_unit(s.design.mode), 'amplitude')}: "
                                 f"{sentence(values)}")
 
     # ---- targets ---------------------------------------------------------------------------------
@@ -204,7 +228,6 @@ class WhatIfView(PlotView):
             self.result.object = f"**Cannot search**: {message}" if message else ""
             self.solutions.visible = self.use.visible = False
             return
-        mode = found.problem.start.mode
         lines = [f"**{found.statement}** ({found.seconds:.2f} s)"]
         rows = self.form.rows()
         if rows:
@@ -213,12 +236,13 @@ class WhatIfView(PlotView):
             lines += ["", "| | " + " | ".join(header + [f"target {j}" for j in range(1, len(targets) + 1)]) + " |",
                       "|---" * (1 + len(header) + len(targets)) + "|"]
             for i, sol in enumerate(rows, 1):
-                got = " | ".join(f"{units.display_stiffness(v, mode):.4g} {units.stiffness_unit(mode)}"
-                                 if t.quantity == "magnitude" and not t.is_ratio else f"{v:.4g}"
-                                 for t, v in zip(targets, sol.achieved))
+                got = " | ".join(shown_measure(t, v) for t, v in zip(targets, sol.achieved))
                 name = f"{i}" if found.solutions else "closest"
                 lines.append(f"| {name} | {found_values(sol.design, ' | ')} | {got} |")
-            lines += [""] + [f"Target {j}: {t.describe()} (SI units)." for j, t in enumerate(targets, 1)]
+            lines += [""] + [f"Target {j}: {target_words(t)}." for j, t in enumerate(targets, 1)]
+        for sol in rows[:1]:  # the limits the statement names, in the fields' units
+            for item in sol.binding:
+                lines[0] = lines[0].replace(item, limit_words(item))
         self.result.object = "\n".join(lines)
         self.solutions.options = {f"{i}: {found_values(s.design, ', ', GEOMETRY, symbols=True)} {A.unit.display}": i - 1
                                   for i, s in enumerate(rows, 1)}
@@ -226,18 +250,16 @@ class WhatIfView(PlotView):
         self.use.label = "Take it into the explorer" if found.solutions else "Take the closest into the explorer"
 
     def __panel__(self):
-        w = FloatInput.from_param
-        tol_grid = pn.GridBox(*(pn.Column(widget, self.tolerance_errors[n], margin=0, sizing_mode="stretch_width")
-                                for n, widget in self.tolerance_inputs.items()), ncols=4, sizing_mode="stretch_width")
+        f = self.form_fields
+        tol_grid = pn.GridBox(*(pn.Column(field, self.tolerance_errors[n], margin=0, sizing_mode="stretch_width")
+                                for n, field in self.tolerance_inputs.items()), ncols=4, sizing_mode="stretch_width")
         form = pn.Column(
-            pn.FlexBox(w(self.form.param.target_magnitude, width=150), w(self.form.param.target_tolerance_pct, width=120),
-                       w(self.form.param.loss_factor_min, width=150), w(self.form.param.ratio_min, width=150),
+            pn.FlexBox(f["target_magnitude"], f["target_tolerance_pct"], f["loss_factor_min"], f["ratio_min"],
                        sizing_mode="stretch_width"),
-            pn.FlexBox(w(self.form.param.b_max_mm, width=150), w(self.form.param.length_max_mm, width=150),
-                       w(self.form.param.thickness_min_mm, width=170),
+            pn.FlexBox(f["b_max_mm"], f["length_max_mm"], f["thickness_min_mm"],
                        pn.widgets.Checkbox.from_param(self.form.param.hold_inner, margin=(28, 10)),
                        sizing_mode="stretch_width"),
-            pn.FlexBox(w(self.form.param.mu_min_mpa, width=150), w(self.form.param.mu_max_mpa, width=150),
+            pn.FlexBox(f["mu_min_mpa"], f["mu_max_mpa"],
                        pn.pane.HTML("<i>A µ range lets the compound vary too.</i>", margin=(28, 10)),
                        sizing_mode="stretch_width"),
             pn.Row(self.find, self.targets_file, self.searching),
@@ -257,6 +279,51 @@ def found_values(design, sep: str, names=tuple(FOUND_COLUMNS), symbols: bool = F
     cells = []
     for n in names:
         p = BY_NAME[n]
-        text = f"{p.unit.to_display(design.value(p.name)):{FOUND_COLUMNS[n]}}"
+        text = format_number(p.unit.to_display(design.value(p.name)), FOUND_COLUMNS[n])
         cells.append(f"{p.symbol} {text}" if symbols else text)
     return sep.join(cells)
+
+
+def shown_measure(target, value: float) -> str:
+    """What a found design achieves for ``target``, in display units: |K| in its mode's unit,
+    a loss factor or a ratio as a number."""
+    if target.quantity == "magnitude" and not target.is_ratio:
+        mode = target.modes[0]
+        return format_value(units.display_stiffness(value, mode), units.stiffness_unit(mode), "stiffness")
+    return format_value(value, "", "ratio" if target.is_ratio else "loss_factor")
+
+
+def target_words(target) -> str:
+    """A target in the display units of the form (``axial |K| = 4.5 kN/mm ± 1 % at 10 Hz, 0.1 mm``)."""
+    t = target
+    amp = " and ".join(format_value(units.display_amplitude(x, m), units.amplitude_unit(m), "amplitude")
+                       for m, x in zip(t.modes, t.amplitudes))
+    what = (f"|K_{t.modes[0]}|/|K_{t.modes[1]}|" if t.is_ratio else
+            f"{t.modes[0]} {'|K|' if t.quantity == 'magnitude' else 'loss factor'}")
+    if t.is_ratio or t.quantity == "loss_factor":
+        def shown(v):
+            return format_value(v, "", "ratio" if t.is_ratio else "loss_factor")
+    else:
+        def shown(v):
+            return format_value(units.display_stiffness(v, t.modes[0]), MODE[t.modes[0]].stiffness.display, "stiffness")
+    if t.value is not None:
+        goal = f"= {shown(t.value)}"
+    else:
+        goal = " and ".join(p for p in ((f"≥ {shown(t.low)}" if t.low is not None else ""),
+                                        (f"≤ {shown(t.high)}" if t.high is not None else "")) if p)
+    return f"{what} {goal} at {format_value(t.frequency_hz, 'Hz', 'frequency')}, {amp}"
+
+
+def limit_words(item: str) -> str:
+    """A limit a found design sits on, as the core words it (``outer_radius ≤ 0.04``, SI), in the
+    field's display unit (``b ≤ 40 mm``); a limit of no design parameter as it is."""
+    name, _, rest = item.partition(" ")
+    op, _, value = rest.partition(" ")
+    p = BY_NAME.get(name)
+    try:
+        number = float(value)
+    except ValueError:
+        return item
+    if p is None:
+        return item
+    return f"{p.symbol} {op} {format_value(p.unit.to_display(number), p.unit.display, 'size')}"

@@ -35,6 +35,7 @@ from ..bushing import check_measured_amplitude, stiffness_points
 from ..data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from ..design import Design
 from ..loops import loop_force
+from ..numbers import format_number
 from ..parameters import BRANCH_PARAMETERS, MATERIAL, Parameter
 from ..parts import as_dict
 from ..registry import parameter, parameter_unit, parameter_values, with_values
@@ -311,14 +312,14 @@ def _warnings(problem: _Problem, sol, intervals: dict, complete: bool) -> tuple[
         if edge and _pushed(spec, sol.x[i], intervals.get(name), edge, span):
             at_edge.add(name)
             unit = _unit_words(name, problem.design.mode)
-            out.append(f"{name} ran to the {edge} end of its fitting range ({values[name]:.3g}{unit}): "
+            out.append(f"{name} ran to the {edge} end of its fitting range ({format_number(values[name], 3)}{unit}): "
                        f"the model cannot follow these data there; check that the design's mode and "
                        f"geometry are those of the measurement")
     for name, (a, b) in intervals.items():
         if (a is None or b is None) and name not in at_edge:
             unit = _unit_words(name, problem.design.mode)
             which = ("any value in its fitting range" if a is None and b is None
-                     else f"any value up to {b:.3g}{unit}" if a is None else f"any value from {a:.3g}{unit} up")
+                     else f"any value up to {format_number(b, 3)}{unit}" if a is None else f"any value from {format_number(a, 3)}{unit} up")
             out.append(f"{name} is not determined by these data: {which} fits them as well "
                        f"({CONFIDENCE:.0%} profile); measure more amplitudes or frequencies to pin it down")
     if not complete:

@@ -41,13 +41,13 @@ def test_clear_the_data_after_a_fit_with_fit_on(page, explorer_url, server_log, 
     page.get_by_role("button", name="Load the synthetic Paper B example").click()
     page.get_by_text("150 points").first.wait_for()
     fit_on = page.get_by_label("Fit on (the rest is predicted)")
-    fit_on.fill("amplitude=1e-4")
+    fit_on.fill("amplitude=0.1")
     fit_on.press("Enter")
     page.get_by_role("button", name="Fit the five material parameters").click()
-    page.get_by_text("Fitted on amplitude=1e-4").wait_for(timeout=60_000)
+    page.get_by_text("Fitted on amplitude=0.1").wait_for(timeout=60_000)
     page.get_by_role("button", name="Clear the data").click()
     expect(page.get_by_text("150 points")).to_have_count(0)
-    expect(page.get_by_text("Fitted on amplitude=1e-4")).to_have_count(0)
+    expect(page.get_by_text("Fitted on amplitude=0.1")).to_have_count(0)
     assert_clean(server_log, bokeh_warnings)
 
 
