@@ -9,12 +9,11 @@ import param
 from core.data import MeasuredStiffness
 from core.effects import EFFECTS
 from core.identify.diagnose import BRANCHES, Diagnosis, diagnose
-from core.io.measured import parse_stiffness
 from core.io.table import csv_text
 from core.synthetic import MYSTERIES, Mystery
 
 from . import curves
-from .state import ExplorerState, read_measured
+from .state import ExplorerState, read_stiffness
 
 
 class DiagnosisState(param.Parameterized):
@@ -46,11 +45,15 @@ class DiagnosisState(param.Parameterized):
         self.param.update(data=data, source=source, result=None, message="", mystery=mystery, revealed=False)
 
     def load_csv(self, content: bytes | str, filename: str = "stiffness file") -> bool:
-        data, message = read_measured(parse_stiffness, content, filename)
+        """A stiffness file, read and judged for the explorer's bushing as the measured-data tab
+        does (:func:`app.state.read_stiffness`): refused with the same message, or loaded with
+        the same warning."""
+        data, message = read_stiffness(content, filename, self.explorer.design)
         if data is None:
             self.message = message
             return False
         self._set_data(data, filename)
+        self.message = message
         return True
 
     def use_measured(self) -> bool:
