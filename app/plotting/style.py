@@ -245,3 +245,26 @@ def sized(layout: hv.Layout, width: int | None) -> hv.Layout:
         return layout
     return layout.map(lambda plot: plot.opts(responsive=False, width=width), [hv.Overlay])
 
+
+
+def amplitude_curves(groups: list, dims: dict, models: tuple, title: str, png: str) -> dict:
+    """Measured points and models against frequency, one colour per amplitude (the data as dots,
+    each model a line at the same amplitude), for |K| and the loss factor. ``groups`` as
+    :func:`app.curves.amplitude_groups`; ``models``: (key in a group, label, line style) each."""
+    palette = SWEEP_PALETTES["amplitude"]
+    out = {}
+    for i, (quantity, ydim) in enumerate((("magnitude", dims["magnitude"]), ("loss", dims["loss_factor"]))):
+        items = []
+        for n, g in enumerate(groups):
+            color = palette[n % len(palette)]
+            label = sweep_label(g["amplitude"], dims["amplitude"].unit)
+            for key, name, style in models:
+                if key in g:
+                    items.append(curve(g["frequency_hz"], g[key][i], dims["frequency"], ydim, f"{label} {name}",
+                                       color=color, **style))
+            items.append(scatter(g["frequency_hz"], g["data"][i], dims["frequency"], ydim, f"{label} data",
+                                 color=color, size=6, alpha=0.8))
+        if not items:  # no data: an empty plot (the view hides it)
+            items.append(scatter([], [], dims["frequency"], ydim, "data", color=palette[0], size=6))
+        out[quantity] = overlay(items, f"{ydim.label}: {title}", f"{png}-{quantity}", legend=None, height=280)
+    return out
