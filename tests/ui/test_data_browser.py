@@ -16,7 +16,7 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 TAB = "Measured data and fit"
 FIT = "Fit the five material parameters"
 DATA_TITLE = "|K|: measured (dots) and model (lines) at each amplitude"
-RESIDUAL_TITLE = "|K|, model − measured, against frequency"
+RESIDUAL_TITLE = "|K| residual, model − measured, against frequency"
 
 # every glyph of a figure: its kind, colour (line or fill) and data
 GLYPHS_JS = """(title) => {
