@@ -119,11 +119,6 @@ def test_measured_points_one_colour_per_amplitude_over_the_model_there(page, exp
 def test_residuals_follow_the_fit(page, explorer_url, tmp_path):
     """After Fit the residuals are the fitted design's (its file, downloaded, gives them
     through core), not the starting design's."""
-    from core.bushing import stiffness_points
-    from core.io.design_file import read_design
-    from core.io.measured import parse_stiffness
-    from core.response import magnitude_residual_pct
-
     open_tab(page, explorer_url)
     page.locator("input[type=file]").first.set_input_files(str(EXAMPLES / "paper_b_stiffness.csv"))
     wait_plot(page, RESIDUAL_TITLE, "p.points > 0")
@@ -136,6 +131,11 @@ def test_residuals_follow_the_fit(page, explorer_url, tmp_path):
     path = tmp_path / "fitted.json"
     download.value.save_as(path)
     json.loads(path.read_text())
+    from core.bushing import stiffness_points
+    from core.io.design_file import read_design
+    from core.io.measured import parse_stiffness
+    from core.response import magnitude_residual_pct
+
     fitted = read_design(path)
     data = parse_stiffness((EXAMPLES / "paper_b_stiffness.csv").read_text())
     expected = magnitude_residual_pct(stiffness_points(fitted, data.frequency_hz, data.amplitude), data.stiffness)
@@ -159,3 +159,35 @@ def test_without_data_a_how_to_and_fit_waits_for_data(page, explorer_url):
     page.get_by_role("button", name="Clear the data").click()
     expect(fit).to_be_disabled()
     expect(page.locator(".measured-how-to")).to_be_visible()
+
+
+# the major ticks of every figure's log x axis whose label names the amplitude, and its range
+LOG_AXES_JS = """() => {
+  const out = [];
+  for (const m of Bokeh.documents[0].all_models) {
+    if (m.type !== 'Figure' || !m.title || m.x_scale.type !== 'LogScale') continue;
+    const axis = m.below[0];
+    if (!axis || !String(axis.axis_label).startsWith('Amplitude')) continue;
+    const view = Bokeh.index.find_one(axis);
+    if (!view) continue;
+    out.push({title: m.title.text, start: m.x_range.start, end: m.x_range.end,
+              ticks: Array.from(view.tick_coords.major[0])});
+  }
+  return out;
+}"""
+
+
+def test_log_amplitude_axes_are_labelled_in_every_part_of_their_range(page, explorer_url):
+    """The measured tab's residuals against amplitude (0.013–0.35 mm, under two decades): a
+    labelled tick in each half (log scale) of the axis, not only at 0.1–0.4."""
+    open_tab(page, explorer_url)
+    page.locator("input[type=file]").first.set_input_files(str(EXAMPLES / "paper_b_stiffness.csv"))
+    wait_plot(page, RESIDUAL_TITLE, "p.points > 0")
+    settle(page)
+    axes = page.evaluate(LOG_AXES_JS)
+    assert len(axes) >= 2, axes
+    for axis in axes:
+        lo, hi = sorted((axis["start"], axis["end"]))
+        middle = np.sqrt(lo * hi)
+        ticks = [t for t in axis["ticks"] if lo <= t <= hi]
+        assert any(t < middle for t in ticks) and any(t > middle for t in ticks), axis
