@@ -115,6 +115,8 @@ class ExplorerState(DesignFields, ToleranceBands):
     data_message = param.String(default="", doc="What was wrong with the last file, if anything.")
     data_note = param.String(default="", doc="What the last load warns of or did beyond loading (a unit "
                              "that looks wrong, the operating point moved to a loop's), if anything.")
+    measured_warning = param.String(default="", doc="The unit warnings of the stiffness loaded (kept with "
+                                    "those data: the diagnosis tab repeats them when it uses them).")
 
     def __init__(self, **params):
         self._loaded = []  # the last design loaded (a file, a fit): kept while the inputs show it
@@ -214,7 +216,7 @@ class ExplorerState(DesignFields, ToleranceBands):
         return True
 
     def clear_measured(self):
-        self.param.update(measured=None, measured_loop=None, data_message="", data_note="")
+        self.param.update(measured=None, measured_loop=None, data_message="", data_note="", measured_warning="")
 
     def load_measured_files(self, files: dict) -> bool:
         """Several measured-stiffness files (name → content) as one table: a file without a mode
@@ -233,8 +235,9 @@ class ExplorerState(DesignFields, ToleranceBands):
         if not parts:
             self.data_message = note
             return False
-        self.param.update(measured=combined(parts, self.design.mode), data_message=note,
-                          data_note=" ".join(w for w in warned if w))
+        warning = " ".join(w for w in warned if w)
+        self.param.update(measured=combined(parts, self.design.mode), data_message=note, data_note=warning,
+                          measured_warning=warning)
         return not refused
 
     def adopt(self, design: Design):

@@ -62,3 +62,11 @@ def on_upload(dropper: pn.widgets.FileDropper, load: Callable[[bytes | str, str]
     """Call ``load(content, filename)`` with the file dropped (the newest one when the drop area
     replaces an earlier file; an empty file too: it gets its message)."""
     on_files(dropper, lambda files: load(*reversed(list(files.items())[-1])))
+
+
+def verdict_html(message: str, note: str = "", kind: str = "data") -> str:
+    """A file's verdict as every tab shows it: a refusal (``message``, red, class
+    ``{kind}-error``) and a warning or note (``note``, amber, class ``{kind}-note``)."""
+    return "".join([f'<div class="{kind}-error" style="color:#b03a2e">⚠ {message}</div>' if message else "",
+                     f'<div class="{kind}-note" style="color:#8a5a00">ⓘ {note}</div>' if note else ""])
+

@@ -23,7 +23,7 @@ from ..live import LivePlot
 from ..plotting.measured_data_and_fit import data_overlays, prediction_overlay, residual_overlays
 from ..plotting.style import ranged
 from ..state import ExplorerState, measured_amplitudes
-from ..uploads import csv_dropper, on_files, on_upload
+from ..uploads import csv_dropper, on_files, on_upload, verdict_html
 from ..views import PlotView
 
 RESIDUALS = (("magnitude", "frequency"), ("loss", "frequency"), ("magnitude", "amplitude"), ("loss", "amplitude"))
@@ -102,9 +102,7 @@ class MeasuredView(PlotView):
     def _show_message(self):
         """What was wrong with the last file (or fit), if anything."""
         m, note = self.state.data_message, self.state.data_note
-        self.message.object = "".join([
-            f'<div class="data-error" style="color:#b03a2e">⚠ {m}</div>' if m else "",
-            f'<div class="data-note" style="color:#8a5a00">ⓘ {note}</div>' if note else ""])
+        self.message.object = verdict_html(m, note)
 
     @param.depends(*FIT_DEPENDS, watch=True)
     def _show_prediction(self):

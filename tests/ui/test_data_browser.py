@@ -55,11 +55,12 @@ def open_tab(page, url):
 def test_a_stiffness_file_in_mm_is_refused_alike_in_both_tabs(page, explorer_url, tmp_path):
     """Amplitudes in mm (0.013–0.35 "m"): refused at upload, the message names the file, the
     column and the cause; the drop area does not say "Upload complete"; the Explorer draws no
-    measured points; the diagnosis tab refuses the same file with the same message."""
+    measured points and says the same; the diagnosis tab refuses the same file with the same
+    message."""
     mm = scaled(tmp_path, "paper_b_stiffness.csv", "in_mm.csv", "amplitude", 1e3)
     open_tab(page, explorer_url)
     page.locator("input[type=file]").first.set_input_files(str(mm))
-    error = page.locator(".data-error")
+    error = page.locator(".data-error:visible")
     expect(error).to_contain_text("in_mm.csv")
     expect(error).to_contain_text("column amplitude")
     expect(error).to_contain_text("look like mm")
@@ -67,6 +68,7 @@ def test_a_stiffness_file_in_mm_is_refused_alike_in_both_tabs(page, explorer_url
     # FilePond's "Upload complete" is not shown next to the refusal (the drop area says "Sent")
     expect(page.locator(".filepond--file-status-main").first).to_have_css("font-size", "0px")
     page.get_by_text("Explorer", exact=True).click()
+    expect(page.locator(".data-error:visible")).to_have_text(error.inner_text())
     settle(page)
     assert "measured" not in plots(page)["|K| against frequency"]["legends"]
     page.get_by_text("Find the missing effect", exact=True).click()
@@ -83,7 +85,7 @@ def test_stiffness_in_kn_per_mm_and_a_torsion_file_in_axial_mode_are_refused(pag
     open_tab(page, explorer_url)
     inputs = page.locator("input[type=file]")
     inputs.first.set_input_files(str(knmm))
-    error = page.locator(".data-error")
+    error = page.locator(".data-error:visible")
     expect(error).to_contain_text("in_kn_per_mm.csv: column magnitude")
     expect(error).to_contain_text("look like kN/mm")
     inputs.first.set_input_files(str(EXAMPLES / "table1_torsion_stiffness.csv"))
@@ -191,3 +193,23 @@ def test_log_amplitude_axes_are_labelled_in_every_part_of_their_range(page, expl
         middle = np.sqrt(lo * hi)
         ticks = [t for t in axis["ticks"] if lo <= t <= hi]
         assert any(t < middle for t in ticks) and any(t > middle for t in ticks), axis
+
+
+def test_a_warned_file_is_a_warning_in_every_tab_and_goes_with_its_data(page, explorer_url, tmp_path):
+    """|K| 30 times the model's (loaded, with a warning naming the file and the column): an amber
+    note, no error, in the measured tab and the Explorer; the diagnosis tab, using those data,
+    repeats the warning as a warning (not as a refusal) and can diagnose them."""
+    far = scaled(tmp_path, "paper_b_stiffness.csv", "thirty_times.csv", "magnitude", 30.0)
+    open_tab(page, explorer_url)
+    page.locator("input[type=file]").first.set_input_files(str(far))
+    note = page.locator(".data-note:visible")
+    expect(note).to_contain_text("thirty_times.csv: column magnitude")
+    said = note.inner_text()
+    expect(page.locator(".data-error:visible")).to_have_count(0)
+    page.get_by_text("Explorer", exact=True).click()
+    expect(page.locator(".data-note:visible")).to_have_text(said)
+    page.get_by_text("Find the missing effect", exact=True).click()
+    page.get_by_role("button", name="Use the data of “Measured data and fit”").click()
+    expect(page.locator(".diagnosis-note")).to_contain_text(said.removeprefix("ⓘ").strip())
+    expect(page.locator(".diagnosis-error")).to_have_count(0)
+    expect(page.get_by_role("button", name="Diagnose")).to_be_enabled()
