@@ -19,7 +19,7 @@ from core.synthetic import paper_b_example
 from .. import curves, units
 from ..curves import padded
 from ..fit_state import FIT_DEPENDS, FitState
-from ..live import LivePlot
+from ..live import LivePlot, update_or_keep
 from ..plotting.measured_data_and_fit import data_overlays, prediction_overlay, residual_overlays
 from ..plotting.style import ranged
 from ..state import ExplorerState, measured_amplitudes
@@ -169,8 +169,13 @@ class MeasuredView(PlotView):
         empty = s.measured is None and s.measured_loop is None
         self.how_to.visible = empty
         self.fit_button.disabled = empty
-        self._draw(points, residuals, groups)
-        self.plots_box.visible = not empty
+        if self.plots_box is None:
+            self._draw(points, residuals, groups, empty)
+        else:  # the text first (one message), the plots in the next: a first upload's new glyphs take the
+            # browser seconds to build, and the verdict and summary do not wait for them
+            pn.state.execute(lambda: update_or_keep("MeasuredView kept its last plots",
+                                                    lambda: self._draw(points, residuals, groups, empty)),
+                             schedule=True)
         options = {f"{units.display_amplitude(a, mode):.4g} {unit}": a for a in measured_amplitudes(s.measured)}
         if options != self.sweep.options:
             self.sweep.options = options
@@ -178,7 +183,7 @@ class MeasuredView(PlotView):
         self.use.disabled = self.download.disabled = r is None
         self.results.object = self._results_table(r) if r is not None else ""
 
-    def _draw(self, points, residuals, groups):
+    def _draw(self, points, residuals, groups, empty: bool):
         dims = self.dims_for(self.state.design.mode)
         if points is not None:  # plots of the same quantity share the axis: one range (one clone) for both
             ranges = {"residual_magnitude": padded([residuals["magnitude_residual_pct"]]),
@@ -193,6 +198,7 @@ class MeasuredView(PlotView):
         self.residuals = LivePlot.shown(self.residuals, items)
         if self.plots_box is None:
             self.plots_box = pn.Column(self.residuals.grid(2), sizing_mode="stretch_width")
+        self.plots_box.visible = not empty
 
     @staticmethod
     def _results_table(r):
