@@ -231,6 +231,8 @@ class ExplorerState(DesignFields, ToleranceBands):
             else:
                 parts.append(data)
                 warned.append(message)
+        if parts:  # each refused file's own "Not loaded." said once, for them all
+            refused = [m.removesuffix(" Not loaded.") for m in refused]
         note = "; ".join(refused) + (" (not loaded; the other files are)" if refused and parts else "")
         if not parts:
             self.data_message = note

@@ -68,5 +68,5 @@ def verdict_html(message: str, note: str = "", kind: str = "data") -> str:
     """A file's verdict as every tab shows it: a refusal (``message``, red, class
     ``{kind}-error``) and a warning or note (``note``, amber, class ``{kind}-note``)."""
     return "".join([f'<div class="{kind}-error" style="color:#b03a2e">⚠ {message}</div>' if message else "",
-                     f'<div class="{kind}-note" style="color:#8a5a00">ⓘ {note}</div>' if note else ""])
+                     f'<div class="{kind}-note" style="color:#8a5a00">Note: {note}</div>' if note else ""])
 

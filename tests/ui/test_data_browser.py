@@ -210,6 +210,6 @@ def test_a_warned_file_is_a_warning_in_every_tab_and_goes_with_its_data(page, ex
     expect(page.locator(".data-note:visible")).to_have_text(said)
     page.get_by_text("Find the missing effect", exact=True).click()
     page.get_by_role("button", name="Use the data of “Measured data and fit”").click()
-    expect(page.locator(".diagnosis-note")).to_contain_text(said.removeprefix("ⓘ").strip())
+    expect(page.locator(".diagnosis-note")).to_contain_text(said.removeprefix("Note:").strip())
     expect(page.locator(".diagnosis-error")).to_have_count(0)
     expect(page.get_by_role("button", name="Diagnose")).to_be_enabled()
