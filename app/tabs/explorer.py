@@ -42,7 +42,7 @@ class ExplorerPlots(PlotView):
 
     @param.depends("state.data_message", "state.data_note", watch=True)
     def _show_verdict(self):
-        self.verdict.object = verdict_html(self.state.data_message, self.state.data_note)
+        self.verdict.object = verdict_html(self.state.data_message, self.state.data_note, "explorer")
 
     def frame(self, key) -> hv.Overlay:
         """What a plot shows now: ``"loop"`` or a (quantity, against) pair of :data:`GRID`."""
