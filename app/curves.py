@@ -392,24 +392,41 @@ def misfit_points(r, which: str) -> dict:
     }
 
 
+def amplitude_groups(data: MeasuredStiffness, mode: str, models: dict, most: int = 5) -> list[dict]:
+    """Measured stiffness (SI, one mode) and models at its points against frequency, one group per
+    measured amplitude (the ``most`` most populated), in display units: each group's
+    ``amplitude``, ``frequency_hz`` (sorted), ``data`` and every model's name (``models``: name →
+    complex K at each row of ``data``) as (|K|, loss factor)."""
+    groups = []
+    for amp in np.sort(data.amplitudes()[:most]):
+        sel = np.flatnonzero(data.amplitude == amp)
+        sel = sel[np.argsort(data.frequency_hz[sel])]
+        group = {"amplitude": float(units.display_amplitude(amp, mode)), "frequency_hz": data.frequency_hz[sel]}
+        for name, k in {"data": data.stiffness, **models}.items():
+            group[name] = (units.display_stiffness(np.abs(k[sel]), mode), loss_factor(k[sel]))
+        groups.append(group)
+    return groups
+
+
 def curve_groups(r, most: int = 5) -> list[dict]:
     """Data and both models of a diagnosis against frequency, one group per measured amplitude
-    (the ``most`` most populated), in display units."""
-    d = r.data
-    mode = r.final.design.mode
-    groups = []
-    for amp in np.sort(d.amplitudes()[:most]):
-        sel = np.flatnonzero(d.amplitude == amp)
-        sel = sel[np.argsort(d.frequency_hz[sel])]
-        kb, kf, kd = r.baseline.stiffness[sel], r.final.stiffness[sel], d.stiffness[sel]
-        groups.append({
-            "amplitude": float(units.display_amplitude(amp, mode)),
-            "frequency_hz": d.frequency_hz[sel],
-            "data": (units.display_stiffness(np.abs(kd), mode), loss_factor(kd)),
-            "baseline": (units.display_stiffness(np.abs(kb), mode), loss_factor(kb)),
-            "final": (units.display_stiffness(np.abs(kf), mode), loss_factor(kf)),
-        })
-    return groups
+    (the ``most`` most populated), in display units (:func:`amplitude_groups`)."""
+    return amplitude_groups(r.data, r.final.design.mode,
+                            {"baseline": r.baseline.stiffness, "final": r.final.stiffness}, most)
+
+
+def measured_groups(measured: MeasuredStiffness | None, start: Design, fitted: Design | None = None) -> list[dict]:
+    """The measured rows in ``start``'s mode (dense data as bin means) against frequency, one
+    group per amplitude, with the model of ``start`` (``"start"``) and, after a fit, of the
+    fitted design (``"fitted"``) at those points (:func:`amplitude_groups`); [] without rows."""
+    data = None if measured is None else measured.of_mode(start.mode)
+    if data is None:
+        return []
+    data = data.binned(DISPLAY_POINTS)
+    models = {"start": stiffness_points(start, data.frequency_hz, data.amplitude)}
+    if fitted is not None:
+        models["fitted"] = stiffness_points(fitted.in_mode(start.mode), data.frequency_hz, data.amplitude)
+    return amplitude_groups(data, start.mode, models)
 
 
 def card_sweeps(design: Design, frequency_hz: float, strains=None) -> dict:

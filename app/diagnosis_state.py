@@ -10,12 +10,11 @@ from core.data import MeasuredStiffness
 from core.effects import EFFECTS, effect_title
 from core.identify.diagnose import BRANCHES, Diagnosis, diagnose
 from core.identify.fit import fitted_name
-from core.io.measured import parse_stiffness
 from core.io.table import csv_text
 from core.synthetic import MYSTERIES, Mystery
 
 from . import curves
-from .state import ExplorerState, read_measured
+from .state import ExplorerState, read_stiffness
 
 
 class DiagnosisState(param.Parameterized):
@@ -32,6 +31,8 @@ class DiagnosisState(param.Parameterized):
     progress = param.Number(default=0.0, bounds=(0.0, 1.0))
     progress_message = param.String(default="")
     message = param.String(default="", doc="What went wrong, if anything.")
+    note = param.String(default="", doc="What the data's units warn of (app.state.read_stiffness), if anything: "
+                        "kept with the data.")
     mystery = param.ClassSelector(class_=Mystery, default=None, allow_None=True,
                                   doc="The demo's hidden truth (shown only after the diagnosis).")
     revealed = param.Boolean(default=False)
@@ -43,15 +44,19 @@ class DiagnosisState(param.Parameterized):
 
     # ---- data ----------------------------------------------------------------------------------
 
-    def _set_data(self, data: MeasuredStiffness, source: str, mystery: Mystery | None = None):
-        self.param.update(data=data, source=source, result=None, message="", mystery=mystery, revealed=False)
+    def _set_data(self, data: MeasuredStiffness, source: str, mystery: Mystery | None = None, note: str = ""):
+        self.param.update(data=data, source=source, result=None, message="", note=note, mystery=mystery,
+                          revealed=False)
 
     def load_csv(self, content: bytes | str, filename: str = "stiffness file") -> bool:
-        data, message = read_measured(parse_stiffness, content, filename)
+        """A stiffness file, read and judged for the explorer's bushing as the measured-data tab
+        does (:func:`app.state.read_stiffness`): refused with the same message, or loaded with
+        the same warning."""
+        data, message = read_stiffness(content, filename, self.explorer.design)
         if data is None:
             self.message = message
             return False
-        self._set_data(data, filename)
+        self._set_data(data, filename, note=message)
         return True
 
     def use_measured(self) -> bool:
@@ -59,7 +64,8 @@ class DiagnosisState(param.Parameterized):
         if self.explorer.measured is None:
             self.message = "No measured stiffness is loaded in the “Measured data and fit” tab."
             return False
-        self._set_data(self.explorer.measured, "the data of the “Measured data and fit” tab")
+        self._set_data(self.explorer.measured, "the data of the “Measured data and fit” tab",
+                       note=self.explorer.measured_warning)
         return True
 
     def load_mystery(self):

@@ -21,6 +21,7 @@ from core import PAPER_B, TABLE_1, Design
 from core.data import DataError, MeasuredLoop, MeasuredStiffness
 from core.io.measured import combined, parse_loop, parse_stiffness
 from core.parameters import MODE_TABLE, MODES
+from core.plausibility import loop_verdict, stiffness_column, stiffness_verdict
 
 from . import curves, units
 from .bands import BAND_INPUTS, ToleranceBands
@@ -42,6 +43,18 @@ def read_measured(parse, content: bytes | str, filename: str):
         return parse(content), ""
     except DataError as exc:
         return None, f"{filename}: {exc}"
+
+
+def read_stiffness(content: bytes | str, filename: str, design: Design):
+    """A measured-stiffness file read and judged for ``design``'s bushing
+    (:func:`core.plausibility.stiffness_verdict`): ``(data, warning)``, or ``(None, message)``
+    for a file refused by its format or by its units. The one route every tab loads a stiffness
+    file by."""
+    data, message = read_measured(parse_stiffness, content, filename)
+    if data is None:
+        return None, message
+    verdict = stiffness_verdict(design, data, filename, stiffness_column(content))
+    return (None, verdict.message) if verdict.refused else (data, verdict.warning)
 
 
 def _shape_doc() -> str:
@@ -100,6 +113,10 @@ class ExplorerState(DesignFields, ToleranceBands):
     measured_loop = param.ClassSelector(class_=MeasuredLoop, default=None, allow_None=True,
                                         doc="A measured steady loop (SI).")
     data_message = param.String(default="", doc="What was wrong with the last file, if anything.")
+    data_note = param.String(default="", doc="What the last load warns of or did beyond loading (a unit "
+                             "that looks wrong, the operating point moved to a loop's), if anything.")
+    measured_warning = param.String(default="", doc="The unit warnings of the stiffness loaded (kept with "
+                                    "those data: the diagnosis tab repeats them when it uses them).")
 
     def __init__(self, **params):
         self._loaded = []  # the last design loaded (a file, a fit): kept while the inputs show it
@@ -159,16 +176,23 @@ class ExplorerState(DesignFields, ToleranceBands):
         return self.load_measured_files({filename: content})
 
     def load_measured_loop(self, content: bytes | str, filename: str = "loop file") -> bool:
-        """Read a measured-loop CSV; the operating point moves to the loop's frequency and
-        amplitude, so that the model's loop is drawn over the measured one."""
+        """Read a measured-loop CSV, judged for the design's bushing
+        (:func:`core.plausibility.loop_verdict`); the operating point moves to the loop's
+        frequency and amplitude, so that the model's loop is drawn over the measured one, and
+        ``data_note`` says so."""
         def parse(text):
             loop = parse_loop(text)
             return loop, loop.harmonic()
 
-        read, self.data_message = read_measured(parse, content, filename)
+        read, message = read_measured(parse, content, filename)
         if read is None:
+            self.data_message = message
             return False
         data, (f, amp, _) = read
+        verdict = loop_verdict(self.design, data, filename)
+        if verdict.refused:
+            self.data_message = verdict.message
+            return False
         x = float(units.display_amplitude(amp, self.design.mode))
         lo, hi = curves.amplitude_bounds(self.design)
         unit = units.amplitude_unit(self.design.mode)
@@ -181,29 +205,41 @@ class ExplorerState(DesignFields, ToleranceBands):
         if problem:
             self.data_message = f"{filename}: {problem}; not loaded"
             return False
-        self.param.update(measured_loop=data,
-                          frequency_hz=float(np.clip(f, *FREQUENCY_BOUNDS)), amplitude=float(f"{x:.4g}"))
+        frequency, amplitude = float(np.clip(f, *FREQUENCY_BOUNDS)), float(f"{x:.4g}")
+        moved = ""
+        if (frequency, amplitude) != (self.frequency_hz, self.amplitude):
+            moved = (f"{filename}: the operating point moved to the loop's {frequency:.4g} Hz and {amplitude:.4g} "
+                     f"{unit} (it was {self.frequency_hz:.4g} Hz, {self.amplitude:.4g} {unit}), so that the "
+                     "model's loop is drawn over the measured one.")
+        self.param.update(measured_loop=data, frequency_hz=frequency, amplitude=amplitude, data_message="",
+                          data_note=" ".join(n for n in (verdict.warning, moved) if n))
         return True
 
     def clear_measured(self):
-        self.param.update(measured=None, measured_loop=None, data_message="")
+        self.param.update(measured=None, measured_loop=None, data_message="", data_note="", measured_warning="")
 
     def load_measured_files(self, files: dict) -> bool:
         """Several measured-stiffness files (name → content) as one table: a file without a mode
-        column is in the design's mode. A bad file is left out with its message; the others
-        load. None good: the last data kept."""
-        parts, refused = [], []
+        column is in the design's mode. A bad file (its format, or units its numbers betray:
+        :func:`read_stiffness`) is left out with its message; the others load. None good: the
+        last data kept."""
+        parts, refused, warned = [], [], []
         for name, content in files.items():
-            data, message = read_measured(parse_stiffness, content, name)
+            data, message = read_stiffness(content, name, self.design)
             if data is None:
                 refused.append(message)
             else:
                 parts.append(data)
+                warned.append(message)
+        if parts:  # each refused file's own "Not loaded." said once, for them all
+            refused = [m.removesuffix(" Not loaded.") for m in refused]
         note = "; ".join(refused) + (" (not loaded; the other files are)" if refused and parts else "")
         if not parts:
             self.data_message = note
             return False
-        self.param.update(measured=combined(parts, self.design.mode), data_message=note)
+        warning = " ".join(w for w in warned if w)
+        self.param.update(measured=combined(parts, self.design.mode), data_message=note, data_note=warning,
+                          measured_warning=warning)
         return not refused
 
     def adopt(self, design: Design):

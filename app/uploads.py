@@ -21,13 +21,22 @@ LIMIT = f"{MAX_BYTES // (1024 * 1024)}MB"
 
 MAX_FILES = 8
 
+# a file sent is not a file loaded: the drop area says "Sent" (not FilePond's green "Upload
+# complete") and the verdict on the file is the tab's message beside it (app.state: data_message)
+SENT_CSS = """
+.filepond--item[data-filepond-item-state='processing-complete'] .filepond--file-status-main { font-size: 0; }
+.filepond--item[data-filepond-item-state='processing-complete'] .filepond--file-status-main::after {
+  content: 'Sent: the verdict is below'; font-size: 0.75rem; }
+.filepond--item[data-filepond-item-state='processing-complete'] .filepond--item-panel { background-color: #5f6b7a; }
+"""
+
 
 def csv_dropper(multiple: bool = False) -> pn.widgets.FileDropper:
     """A drop area for one CSV file (or up to :data:`MAX_FILES`) of at most :data:`MAX_BYTES` each."""
     return pn.widgets.FileDropper(
         accepted_filetypes=[".csv", "text/csv", "text/plain"], max_file_size=LIMIT, chunk_size=CHUNK_BYTES,
         multiple=multiple, max_files=MAX_FILES if multiple else None, previews=[], layout="compact",
-        sizing_mode="stretch_width", **({"min_height": 90} if multiple else {"height": 90}),  # a list grows
+        sizing_mode="stretch_width", stylesheets=[SENT_CSS], **({"min_height": 90} if multiple else {"height": 90}),  # a list grows
     )
 
 
@@ -64,3 +73,11 @@ def on_upload(dropper: pn.widgets.FileDropper, load: Callable[[bytes | str, str]
     """Call ``load(content, filename)`` with the file dropped (the newest one when the drop area
     replaces an earlier file; an empty file too: it gets its message)."""
     on_files(dropper, lambda files: load(*reversed(list(files.items())[-1])))
+
+
+def verdict_html(message: str, note: str = "", kind: str = "data") -> str:
+    """A file's verdict as every tab shows it: a refusal (``message``, red, class
+    ``{kind}-error``) and a warning or note (``note``, amber, class ``{kind}-note``)."""
+    return "".join([f'<div class="{kind}-error" style="color:#b03a2e">⚠ {message}</div>' if message else "",
+                     f'<div class="{kind}-note" style="color:#8a5a00">Note: {note}</div>' if note else ""])
+

@@ -13,6 +13,7 @@ import sys
 import time
 import warnings
 from contextlib import contextmanager
+from pathlib import Path
 
 import numpy as np
 
@@ -25,6 +26,7 @@ from core.io.table import csv_text
 from core.loops import loop
 from core.material import ConvergenceError
 from core.parameters import BRANCH_PARAMETERS, MODE, ROTATIONS, TRANSLATIONS
+from core.plausibility import loop_verdict, stiffness_column, stiffness_verdict
 from core.rules import DECIMAL, OVERFLOW, WHOLE, DesignError, RuleError, decimal
 
 NUMBER_FORMAT = "{:.12g}"
@@ -353,13 +355,30 @@ def _fail(message: str, status: int):
 MAX_MEASURED_FILES = 20
 
 
+def _head(path) -> bytes:
+    """A file's first bytes (its header)."""
+    with open(path, "rb") as f:
+        return f.read(4096)
+
+
+def _judged(verdict) -> None:
+    """A file's units judged for the bushing (:mod:`core.plausibility`), as the explorer judges
+    them: refused (status 2), or a warning on stderr."""
+    if verdict.refused:
+        raise InputError(f"bushing: {verdict.message}")
+    if verdict.warning:
+        sys.stderr.write(f"bushing: warning: {verdict.warning}\n")
+
+
 def _read_measured(paths: list[str], design):
-    """The measured files as one table (rows without a mode in the design's mode)."""
+    """The measured files as one table (rows without a mode in the design's mode), each judged
+    for the design's bushing (:func:`_judged`)."""
     if len(paths) > MAX_MEASURED_FILES:
         raise InputError(f"bushing: at most {MAX_MEASURED_FILES} measured files, got {len(paths)}")
     parts, rows = [], 0
     for path in paths:
         parts.append(read_stiffness(path))
+        _judged(stiffness_verdict(design, parts[-1], Path(path).name, stiffness_column(_head(path))))
         rows += len(parts[-1])
         if rows > MAX_ROWS:
             raise InputError(f"bushing: the measured files hold more than {MAX_ROWS} rows together")
@@ -372,6 +391,8 @@ def _cmd_fit(args) -> None:
     design = read_design(args.design)
     data = _read_measured(args.measured, design)
     loop_data = read_loop(args.loop) if args.loop else None
+    if loop_data is not None:
+        _judged(loop_verdict(design, loop_data, Path(args.loop).name))
     if args.fit_on is None:
         result = fit_global(design, data, loop_data)
     else:

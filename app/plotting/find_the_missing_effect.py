@@ -9,15 +9,12 @@ import numpy as np
 
 from .. import curves
 from .style import (
-    SWEEP_PALETTES,
-    curve,
+    amplitude_curves,
     dimensions,
     overlay,
     ranged,
-    scatter,
     sized,
     styled,
-    sweep_label,
 )
 
 MISFIT_PNG = {"magnitude_pct": "magnitude", "loss_factor": "loss"}
@@ -39,22 +36,9 @@ def diagnosis_curves(groups: list, dims: dict) -> dict:
     """Data (points) against the baseline (dashed) and the final model (solid), one colour per
     amplitude, for |K| and the loss factor (``groups`` as
     :meth:`app.diagnosis_state.DiagnosisState.curves`)."""
-    palette = SWEEP_PALETTES["amplitude"]
-    out = {}
-    for i, (quantity, ydim) in enumerate((("magnitude", dims["magnitude"]), ("loss", dims["loss_factor"]))):
-        items = []
-        for n, g in enumerate(groups):
-            color = palette[n % len(palette)]
-            label = sweep_label(g["amplitude"], dims["amplitude"].unit)
-            items.append(curve(g["frequency_hz"], g["baseline"][i], dims["frequency"], ydim, f"{label} baseline",
-                               color=color, line_dash="dashed", line_width=1.5))
-            items.append(curve(g["frequency_hz"], g["final"][i], dims["frequency"], ydim, f"{label} final",
-                               color=color, line_width=2))
-            items.append(scatter(g["frequency_hz"], g["data"][i], dims["frequency"], ydim, f"{label} data",
-                                 color=color, size=6, alpha=0.8))
-        out[quantity] = overlay(items, f"{ydim.label}: data, baseline and final model",
-                                f"bushing-diagnosis-{quantity}", legend=None, height=280)
-    return out
+    return amplitude_curves(groups, dims, (("baseline", "baseline", {"line_dash": "dashed", "line_width": 1.5}),
+                                           ("final", "final", {"line_width": 2})),
+                            "data, baseline and final model", "bushing-diagnosis")
 
 
 def misfit_map(m: dict, column: str, title: str, dims: dict, limit: float, png: str) -> hv.Overlay:

@@ -14,6 +14,7 @@ from .. import curves
 from .style import (
     MODE_COLORS,
     OPERATING_COLOR,
+    amplitude_curves,
     dimensions,
     overlay,
     scatter,
@@ -37,6 +38,17 @@ def residual_overlays(points: dict | None, residuals: dict | None, dims: dict) -
                 title, f"bushing-residual-{quantity}-vs-{against}", logx=against == "amplitude", legend=None,
                 height=240)
     return out
+
+
+def data_overlays(groups: list, dims: dict) -> dict:
+    """The measured points, one colour per amplitude, over the model at those amplitudes: the
+    design shown (``"start"``, dashed after a fit) and the fitted one (``"fitted"``, solid);
+    ``groups`` as :func:`app.curves.measured_groups`. Keys "magnitude" and "loss"."""
+    fitted = bool(groups) and "fitted" in groups[0]
+    models = ((("start", "start", {"line_dash": "dashed", "line_width": 1.5}),
+               ("fitted", "fitted", {"line_width": 2})) if fitted else (("start", "model", {"line_width": 2}),))
+    return amplitude_curves(groups, dims, models, "measured (dots) and model (lines) at each amplitude",
+                            "bushing-measured")
 
 
 def prediction_overlay(data: dict) -> hv.Overlay:

@@ -14,7 +14,7 @@ import functools
 import holoviews as hv
 import holoviews.plotting.bokeh
 import numpy as np
-from bokeh.models import CustomJSTickFormatter, SaveTool
+from bokeh.models import CustomJSTicker, CustomJSTickFormatter, SaveTool
 from holoviews.core.util import dimension_sanitizer
 
 from core.numbers import TICK_JS, format_value
@@ -137,6 +137,49 @@ def ticks(plot, _element):
             axis.formatter = CustomJSTickFormatter(code=TICK_JS)
 
 
+# log-axis ticks labelled in every part of the range: Bokeh's LogTicker, on a range of less than
+# two decades, ticks it linearly (0.1, 0.2, 0.3 on 0.013–0.35 mm: the lower decade unlabelled)
+LOG_TICKS_JS = """
+const lo = Math.min(cb_data.start, cb_data.end), hi = Math.max(cb_data.start, cb_data.end);
+if (!(lo > 0) || !(hi > lo) || !isFinite(hi)) return [];
+const decades = Math.log10(hi / lo);
+const tick = (m, e) => Number((m * Math.pow(10, e)).toPrecision(12));
+const within = (mantissas) => {
+  const out = [];
+  for (let e = Math.floor(Math.log10(lo)); e <= Math.ceil(Math.log10(hi)); e++)
+    for (const m of mantissas) { const v = tick(m, e); if (v >= lo && v <= hi) out.push(v); }
+  return out;
+};
+for (const mantissas of (decades > 5 ? [[1]] : decades > 2.5 ? [[1], [1, 3]] : decades > 1 ? [[1, 2, 5]]
+                         : [[1, 2, 5], [1, 2, 3, 4, 5, 6, 7, 8, 9]])) {
+  const ticks = within(mantissas);
+  if (ticks.length >= 3 || (mantissas.length === 9 && ticks.length >= 2)) return ticks;
+}
+// under a factor of ~2 (a zoom): a linear 1-2-5 step
+const step0 = (hi - lo) / 4, p = Math.pow(10, Math.floor(Math.log10(step0)));
+const step = [1, 2, 5, 10].map(m => m * p).find(s => s >= step0);
+const out = [];
+for (let v = Math.ceil(lo / step) * step; v <= hi; v += step) out.push(Number(v.toPrecision(12)));
+return out;
+"""
+LOG_MINOR_JS = """
+const lo = Math.min(cb_data.start, cb_data.end), hi = Math.max(cb_data.start, cb_data.end);
+if (!(lo > 0) || !(hi > lo) || !isFinite(hi) || Math.log10(hi / lo) > 5) return [];
+const out = [];
+for (let e = Math.floor(Math.log10(lo)); e <= Math.ceil(Math.log10(hi)); e++)
+  for (let m = 1; m < 10; m++) { const v = Number((m * Math.pow(10, e)).toPrecision(12)); if (v >= lo && v <= hi) out.push(v); }
+return out;
+"""
+
+
+def log_ticks(plot, _element):
+    """A hook labelling a log x axis in every part of its range (:data:`LOG_TICKS_JS`: powers of
+    ten over many decades, 1-2-5 over one or two, 1…9 within one); its labels are :func:`ticks`'."""
+    for axis in plot.state.xaxis:
+        if not isinstance(axis.ticker, CustomJSTicker):
+            axis.ticker = CustomJSTicker(major_code=LOG_TICKS_JS, minor_code=LOG_MINOR_JS)
+
+
 @functools.cache
 def png_name(name: str):
     """A hook naming the PNG that a plot's save tool writes (one function per name: the hooks
@@ -237,7 +280,7 @@ def scatter(x, y, xdim, ydim, label, **style):
 def overlay(items, title, png, *, logx=False, logy=False, legend="right", height=300):
     legend_opts = {"click_policy": "mute", "label_text_font_size": "11px", "spacing": 0, "padding": 4,
                    "margin": 4}
-    hooks = [canvas, ticks, png_name(png)] + ([legend_outside] if legend == "right" else [])
+    hooks = [canvas, ticks, png_name(png)] + ([legend_outside] if legend == "right" else []) + ([log_ticks] if logx else [])
     options = {"title": title, "responsive": True, "height": height, "logx": logx, "logy": logy,
                "framewise": True, "hooks": hooks, "legend_opts": legend_opts,
                "fontsize": {"title": "13px"}, "show_legend": legend is not None}
@@ -282,3 +325,26 @@ def sized(layout: hv.Layout, width: int | None) -> hv.Layout:
         return layout
     return layout.map(lambda plot: plot.opts(responsive=False, width=width), [hv.Overlay])
 
+
+
+def amplitude_curves(groups: list, dims: dict, models: tuple, title: str, png: str) -> dict:
+    """Measured points and models against frequency, one colour per amplitude (the data as dots,
+    each model a line at the same amplitude), for |K| and the loss factor. ``groups`` as
+    :func:`app.curves.amplitude_groups`; ``models``: (key in a group, label, line style) each."""
+    palette = SWEEP_PALETTES["amplitude"]
+    out = {}
+    for i, (quantity, ydim) in enumerate((("magnitude", dims["magnitude"]), ("loss", dims["loss_factor"]))):
+        items = []
+        for n, g in enumerate(groups):
+            color = palette[n % len(palette)]
+            label = sweep_label(g["amplitude"], dims["amplitude"].unit)
+            for key, name, style in models:
+                if key in g:
+                    items.append(curve(g["frequency_hz"], g[key][i], dims["frequency"], ydim, f"{label} {name}",
+                                       color=color, **style))
+            items.append(scatter(g["frequency_hz"], g["data"][i], dims["frequency"], ydim, f"{label} data",
+                                 color=color, size=6, alpha=0.8))
+        if not items:  # no data: an empty plot (the view hides it)
+            items.append(scatter([], [], dims["frequency"], ydim, "data", color=palette[0], size=6))
+        out[quantity] = overlay(items, f"{ydim.label}: {title}", f"{png}-{quantity}", legend=None, height=280)
+    return out

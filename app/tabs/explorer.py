@@ -17,6 +17,7 @@ from ..live import LivePlot
 from ..plotting.explorer import explorer_overlays
 from ..shapes import shape_pane
 from ..state import ExplorerState
+from ..uploads import verdict_html
 from ..views import PlotView
 
 GRID = (("magnitude", "frequency"), ("magnitude", "amplitude"), ("loss_factor", "frequency"),
@@ -35,9 +36,16 @@ class ExplorerPlots(PlotView):
         super().__init__(state, fit=fit, **params)
         self.summary = pn.pane.HTML("", sizing_mode="stretch_width", css_classes=["operating-point"],
                                     margin=(0, 10))
+        # the verdict on the last measured file, as the measured-data tab says it (one message)
+        self.verdict = pn.pane.HTML("", sizing_mode="stretch_width", margin=(0, 10))
+        self._show_verdict()
         self.loop: LivePlot | None = None
         self.grid: LivePlot | None = None
         self.draw()
+
+    @param.depends("state.data_message", "state.data_note", watch=True)
+    def _show_verdict(self):
+        self.verdict.object = verdict_html(self.state.data_message, self.state.data_note, "explorer")
 
     def frame(self, key) -> hv.Overlay:
         """What a plot shows now: ``"loop"`` or a (quantity, against) pair of :data:`GRID`."""
@@ -73,7 +81,8 @@ class ExplorerPlots(PlotView):
         )
 
     def __panel__(self):
-        return pn.Column(self.summary, shape_pane(self.state), self.loop.pane, self.grid.grid(2), sizing_mode="stretch_width")
+        return pn.Column(self.verdict, self.summary, shape_pane(self.state), self.loop.pane, self.grid.grid(2),
+                         sizing_mode="stretch_width")
 
 
 def band_words(p: dict, unit: str) -> str:

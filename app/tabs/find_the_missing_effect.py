@@ -22,7 +22,7 @@ from ..plotting.find_the_missing_effect import diagnosis_overlays
 from ..plotting.style import SWEEP_PALETTES, sweep_label
 from ..shapes import shape_pane
 from ..units import amplitude_unit
-from ..uploads import csv_dropper, on_upload
+from ..uploads import csv_dropper, on_upload, verdict_html
 from ..work import PageClosed, in_thread
 
 log = logging.getLogger("bushing.app")
@@ -105,7 +105,7 @@ class DiagnosisView(pn.viewable.Viewer):
             self.truth,
             visible=False, sizing_mode="stretch_width",
         )
-        state.param.watch(self._refresh, ["data", "source", "message", "result", "running", "mystery", "revealed"])
+        state.param.watch(self._refresh, ["data", "source", "message", "note", "result", "running", "mystery", "revealed"])
         state.param.watch(self._on_progress, ["progress", "progress_message"])
         self._refresh()
 
@@ -150,8 +150,7 @@ class DiagnosisView(pn.viewable.Viewer):
 
     def _update(self):
         s = self.state
-        self.message.object = (f'<div class="diagnosis-error" style="color:#b03a2e">⚠ {s.message}</div>'
-                               if s.message else "")
+        self.message.object = verdict_html(s.message, s.note, "diagnosis")
         if s.data is not None:
             d = s.data
             modes = d.modes(s.explorer.design.mode).astype(str)

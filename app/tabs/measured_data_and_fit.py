@@ -21,15 +21,29 @@ from .. import curves, units
 from ..curves import padded
 from ..fit_state import FIT_DEPENDS, FitState
 from ..inputs import tip
-from ..live import LivePlot
-from ..plotting.measured_data_and_fit import prediction_overlay, residual_overlays
+from ..live import LivePlot, update_or_keep
+from ..plotting.measured_data_and_fit import data_overlays, prediction_overlay, residual_overlays
 from ..plotting.style import ranged
 from ..shapes import shape_pane
 from ..state import ExplorerState, measured_amplitudes
-from ..uploads import csv_dropper, on_files, on_upload
+from ..uploads import csv_dropper, on_files, on_upload, verdict_html
 from ..views import PlotView
 
 RESIDUALS = (("magnitude", "frequency"), ("loss", "frequency"), ("magnitude", "amplitude"), ("loss", "amplitude"))
+DATA = ("magnitude", "loss")  # the data-over-model plots, drawn before the residuals
+
+# what the tab shows until data are loaded (instead of empty plots)
+HOW_TO = """**No measured data loaded yet.** To fit this bushing's material:
+
+1. Drop a **stiffness CSV** above: one row per point, `frequency_hz,amplitude,magnitude,loss_factor` (Hz, m or rad,
+   N/m or N·m/rad; or `stiffness_real,stiffness_imag`, an optional `mode` column; docs/files.md, About tab).
+2. Optionally a **loop CSV**: `time_s,displacement,force` (s, m or rad, N or N·m).
+3. Press **Fit**.
+
+No file at hand? Press *Load the synthetic Paper B example*, or try the files in the repository's `examples/`
+folder: `paper_b_stiffness.csv` with `paper_b_loop.csv` (Paper B preset, axial), `table1_torsion_stiffness.csv`
+(Table 1 preset, torsion). A file whose numbers are in other units (mm, kN/mm, another direction) is refused with
+the likely cause."""
 
 log = logging.getLogger("bushing.app")
 
@@ -73,6 +87,7 @@ class MeasuredView(PlotView):
                                                 label="Fitted design file (JSON)", disabled=True,
                                                 sizing_mode="stretch_width")
         self.message = pn.pane.HTML("", sizing_mode="stretch_width")
+        self.how_to = pn.pane.Markdown(HOW_TO, sizing_mode="stretch_width", css_classes=["measured-how-to"])
         self.summary = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.results = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.prediction = pn.pane.HoloViews(None, sizing_mode="stretch_width", linked_axes=False)
@@ -81,15 +96,16 @@ class MeasuredView(PlotView):
         # take (AttributeError, and the change lost)
         self.prediction_box = pn.Column(self.prediction, visible=False, sizing_mode="stretch_width")
         self.residuals: LivePlot | None = None
+        self.plots_box: pn.Column | None = None  # the plots, hidden (with the fit's controls) without data
         self._show_message()
         self._show_prediction()
         self.draw()
 
-    @param.depends("state.data_message", watch=True)
+    @param.depends("state.data_message", "state.data_note", watch=True)
     def _show_message(self):
         """What was wrong with the last file (or fit), if anything."""
-        m = self.state.data_message
-        self.message.object = f'<div class="data-error" style="color:#b03a2e">⚠ {m}</div>' if m else ""
+        m, note = self.state.data_message, self.state.data_note
+        self.message.object = verdict_html(m, note)
 
     @param.depends(*FIT_DEPENDS, watch=True)
     def _show_prediction(self):
@@ -101,7 +117,7 @@ class MeasuredView(PlotView):
 
     def frame(self, quantity: str, against: str):
         """What a residual plot shows now (``quantity`` "magnitude" or "loss")."""
-        return self.residuals.current[RESIDUALS.index((quantity, against))]
+        return self.residuals.current[len(DATA) + RESIDUALS.index((quantity, against))]
 
     def _load_example(self, _event):
         data, loop = paper_b_example(PAPER_B)
@@ -125,7 +141,10 @@ class MeasuredView(PlotView):
         mode = s.design.mode
         unit = units.amplitude_unit(mode)
         points = curves.measured_points(s.measured, mode)
-        residuals = None if s.measured is None else curves.measured_residuals(s.design, s.measured)
+        r = self.fit.fit_result
+        shown = s.design if r is None else r.design  # after a fit, the residuals are the fitted design's
+        residuals = None if s.measured is None else curves.measured_residuals(shown, s.measured)
+        groups = curves.measured_groups(s.measured, s.design, None if r is None else r.design)
         lines = []
         if s.measured is not None:
             d = s.measured
@@ -138,7 +157,8 @@ class MeasuredView(PlotView):
                 lines.append(
                     f"**Stiffness**: {len(d)} points{modes}{shown}, {format_number(d.frequency_hz.min(), 'frequency')}–"
                     f"{format_value(d.frequency_hz.max(), 'Hz', 'frequency')}, amplitudes {format_number(points['amplitude'].min(), 'amplitude')}–"
-                    f"{format_value(points['amplitude'].max(), unit, 'amplitude')}; gap of the current design: "
+                    f"{format_value(points['amplitude'].max(), unit, 'amplitude')}; gap of the "
+                    f"{'current' if r is None else 'fitted'} design: "
                     f"**{residuals['gap']:.4f}**"
                     + (f" (drawn as {len(points['frequency_hz'])} bin means; fits bin them too)"
                        if len(points["frequency_hz"]) < len(d.of_mode(s.design.mode)) else ""))
@@ -146,24 +166,43 @@ class MeasuredView(PlotView):
             f, amp, _ = s.measured_loop.harmonic()
             lines.append(f"**Loop**: {s.measured_loop.time_s.size} samples at {format_value(f, 'Hz', 'frequency')}, amplitude "
                          f"{format_value(units.display_amplitude(amp, mode), unit, 'amplitude')}")
-        self.summary.object = "\n\n".join(lines) or "_No measured data loaded._"
-        self._draw(points, residuals)
+        if lines and r is not None:
+            lines.append("The plots below show the **fitted** design (solid) and the start (dashed); the residuals "
+                         "are the fitted design's.")
+        self.summary.object = "\n\n".join(lines)
+        empty = s.measured is None and s.measured_loop is None
+        self.how_to.visible = empty
+        self.fit_button.disabled = empty
+        if self.plots_box is None:
+            self._draw(points, residuals, groups, empty)
+        else:  # the text first (one message), the plots in the next: a first upload's new glyphs take the
+            # browser seconds to build, and the verdict and summary do not wait for them
+            pn.state.execute(lambda: update_or_keep("MeasuredView kept its last plots",
+                                                    lambda: self._draw(points, residuals, groups, empty)),
+                             schedule=True)
         options = {format_value(units.display_amplitude(a, mode), unit): a for a in measured_amplitudes(s.measured)}
         if options != self.sweep.options:
             self.sweep.options = options
         self.sweep.visible = self.fit.fit_method == "two-step"
-        r = self.fit.fit_result
         self.use.disabled = self.download.disabled = r is None
         self.results.object = self._results_table(r) if r is not None else ""
 
-    def _draw(self, points, residuals):
+    def _draw(self, points, residuals, groups, empty: bool):
         dims = self.dims_for(self.state.design.mode)
         if points is not None:  # plots of the same quantity share the axis: one range (one clone) for both
-            dims = ranged(dims, {"residual_magnitude": padded([residuals["magnitude_residual_pct"]]),
-                                 "residual_loss": padded([residuals["loss_factor_residual"]])})
+            ranges = {"residual_magnitude": padded([residuals["magnitude_residual_pct"]]),
+                      "residual_loss": padded([residuals["loss_factor_residual"]])}
+            for i, quantity in enumerate(("magnitude", "loss_factor")):  # the data and every model in view
+                ranges[quantity] = padded([v for g in groups for k in ("data", "start", "fitted") if k in g
+                                           for v in (g[k][i],)])
+            dims = ranged(dims, ranges)
+        data = data_overlays(groups, dims)
         overlays = residual_overlays(points, residuals, dims)
-        items = [overlays[k] for k in RESIDUALS]
+        items = [data[k] for k in DATA] + [overlays[k] for k in RESIDUALS]
         self.residuals = LivePlot.shown(self.residuals, items)
+        if self.plots_box is None:
+            self.plots_box = pn.Column(self.residuals.grid(2), sizing_mode="stretch_width")
+        self.plots_box.visible = not empty
 
     @staticmethod
     def _results_table(r):
@@ -213,12 +252,13 @@ class MeasuredView(PlotView):
             pn.Row(self.example, self.clear),
             shape_pane(self.state),
             self.message,
+            self.how_to,
             self.summary,
             pn.Row(self.method, self.sweep, self.fit_on),
             pn.Row(self.fit_button, self.use),
             self.download,
             self.results,
             self.prediction_box,
-            self.residuals.grid(2),
+            self.plots_box,
             sizing_mode="stretch_width",
         )
