@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .bushing import MIN_MEASURED_STRAIN, stiffness_points
+from .bushing import MIN_MEASURED_STRAIN, check_measured_amplitude, stiffness_points
 from .data import MeasuredLoop, MeasuredStiffness
 from .design import Design
 from .parameters import MODE, MODE_TABLE, MODES
@@ -98,12 +98,12 @@ def _mode_cause(design: Design, other: str | None) -> str:
     """A file of another direction: the one named, or any of the other kind of motion."""
     if other is not None:
         unit = MODE[other]
-        return (f"it looks like a {other} file ({unit.amplitude.si}, {unit.stiffness.si}): switch the explorer's "
-                f"mode to {other} first")
+        return (f"it looks like a {other} file ({unit.amplitude.si}, {unit.stiffness.si}): give the design "
+                f"in {other} mode (the explorer: switch its mode) first")
     kind = [m for m in MODE_TABLE if m.rotation != MODE[design.mode].rotation]
     names = " or ".join(m.name for m in kind)
     return (f"both columns are off: it looks like a file of another direction ({names}: "
-            f"{kind[0].amplitude.si}, {kind[0].stiffness.si}); switch the explorer's mode first")
+            f"{kind[0].amplitude.si}, {kind[0].stiffness.si}); give the design in that mode (the explorer: switch its mode) first")
 
 
 def _median_ratio(design: Design, frequency_hz, amplitude, magnitude) -> float:
@@ -129,17 +129,23 @@ def _judge(design: Design, filename: str, frequency_hz, amplitude, magnitude, co
     ratio = _median_ratio(design, frequency_hz, amplitude, magnitude)
     far = max(ratio, 1 / ratio)
     if top > MAX_PLAUSIBLE_STRAIN or bottom < MIN_MEASURED_STRAIN:
+        where = f"{filename}: column {amplitude_column}"
+        try:  # the data rule (resolution to breaking strain), in its own words
+            check_measured_amplitude(design, amplitude, where)
+            said = (f"{where}: {_span(amplitude, a_unit)} would strain this {design.mode} bushing up to "
+                    f"{top:.3g}, beyond any rubber")
+        except ValueError as exc:
+            if top <= MAX_PLAUSIBLE_STRAIN:  # below resolution: the rule says why and what to check
+                return Verdict(True, (f"{exc} Not loaded.",))
+            said = str(exc)
         milli = ratio * 1e3 if per_amplitude else ratio  # as if the amplitudes were mm
-        if top > MAX_PLAUSIBLE_STRAIN and max(milli, 1 / milli) < REFUSED_RATIO:
+        if max(milli, 1 / milli) < REFUSED_RATIO:
             likely = f"the amplitudes look like {'degrees or mrad' if mode.rotation else 'mm'}, not {a_unit}"
         elif far >= REFUSED_RATIO:
             likely = _mode_cause(design, _other_mode(design, amplitude, frequency_hz, magnitude, REFUSED_RATIO))
         else:
-            likely = f"are they in {a_unit}?"
-        what = (f"would strain this {design.mode} bushing up to {top:.3g}, beyond any rubber"
-                if top > MAX_PLAUSIBLE_STRAIN else "are below any test's resolution for this bushing")
-        return Verdict(True, ((f"{filename}: column {amplitude_column}: {_span(amplitude, a_unit)} {what}; "
-                              f"{likely}. Not loaded."),))
+            likely = f"check that they are in {a_unit}"
+        return Verdict(True, (f"{said}; {likely}. Not loaded.",))
     if far < WARNED_RATIO:
         return PLAUSIBLE
     said = (f"{filename}: column {column}: the measured |K| is {ratio:.3g} × this {design.mode} design's "
