@@ -16,7 +16,7 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 TAB = "Measured data and fit"
 FIT = "Fit the five material parameters"
 DATA_TITLE = "|K|: measured (dots) and model (lines) at each amplitude"
-RESIDUAL_TITLE = "|K| residual, model − measured, against frequency"
+RESIDUAL_TITLE = "|K| residual against frequency"
 
 # every glyph of a figure: its kind, colour (line or fill) and data
 GLYPHS_JS = """(title) => {
@@ -59,7 +59,7 @@ def test_a_stiffness_file_in_mm_is_refused_alike_in_both_tabs(page, explorer_url
     message."""
     mm = scaled(tmp_path, "paper_b_stiffness.csv", "in_mm.csv", "amplitude", 1e3)
     open_tab(page, explorer_url)
-    page.locator("input[type=file]").first.set_input_files(str(mm))
+    page.locator("#main input[type=file]").first.set_input_files(str(mm))
     error = page.locator(".data-error:visible")
     expect(error).to_contain_text("in_mm.csv")
     expect(error).to_contain_text("column amplitude")
@@ -74,7 +74,7 @@ def test_a_stiffness_file_in_mm_is_refused_alike_in_both_tabs(page, explorer_url
     assert "measured" not in plots(page)["|K| against frequency"]["legends"]
     page.get_by_text("Find the missing effect", exact=True).click()
     page.get_by_role("button", name="Diagnose").wait_for()
-    page.locator("input[type=file]").last.set_input_files(str(mm))
+    page.locator("#main input[type=file]").last.set_input_files(str(mm))
     expect(page.locator(".diagnosis-error")).to_contain_text(said)
     assert page.get_by_role("button", name="Diagnose").is_disabled()
 
@@ -84,7 +84,7 @@ def test_stiffness_in_kn_per_mm_and_a_torsion_file_in_axial_mode_are_refused(pag
     Paper B axial design: each refused, naming its column and the likely cause."""
     knmm = scaled(tmp_path, "paper_b_stiffness.csv", "in_kn_per_mm.csv", "magnitude", 1e-6)
     open_tab(page, explorer_url)
-    inputs = page.locator("input[type=file]")
+    inputs = page.locator("#main input[type=file]")
     inputs.first.set_input_files(str(knmm))
     error = page.locator(".data-error:visible")
     expect(error).to_contain_text("in_kn_per_mm.csv: column magnitude")
@@ -123,7 +123,7 @@ def test_residuals_follow_the_fit(page, explorer_url, tmp_path):
     """After Fit the residuals are the fitted design's (its file, downloaded, gives them
     through core), not the starting design's."""
     open_tab(page, explorer_url)
-    page.locator("input[type=file]").first.set_input_files(str(EXAMPLES / "paper_b_stiffness.csv"))
+    page.locator("#main input[type=file]").first.set_input_files(str(EXAMPLES / "paper_b_stiffness.csv"))
     wait_plot(page, RESIDUAL_TITLE, "p.points > 0")
     before = plots(page)[RESIDUAL_TITLE]
     page.get_by_role("button", name=FIT).click()
@@ -155,7 +155,7 @@ def test_without_data_a_how_to_and_fit_waits_for_data(page, explorer_url):
     expect(page.locator(".measured-how-to")).to_contain_text("frequency_hz,amplitude,magnitude,loss_factor")
     fit = page.get_by_role("button", name=FIT)
     expect(fit).to_be_disabled()
-    page.locator("input[type=file]").nth(1).set_input_files(str(EXAMPLES / "paper_b_loop.csv"))
+    page.locator("#main input[type=file]").nth(1).set_input_files(str(EXAMPLES / "paper_b_loop.csv"))
     expect(page.locator(".data-note")).to_contain_text("operating point moved to the loop's 0.1 Hz")
     expect(fit).to_be_enabled()
     expect(page.locator(".measured-how-to")).to_be_hidden()
@@ -184,7 +184,7 @@ def test_log_amplitude_axes_are_labelled_in_every_part_of_their_range(page, expl
     """The measured tab's residuals against amplitude (0.013–0.35 mm, under two decades): a
     labelled tick in each half (log scale) of the axis, not only at 0.1–0.4."""
     open_tab(page, explorer_url)
-    page.locator("input[type=file]").first.set_input_files(str(EXAMPLES / "paper_b_stiffness.csv"))
+    page.locator("#main input[type=file]").first.set_input_files(str(EXAMPLES / "paper_b_stiffness.csv"))
     wait_plot(page, RESIDUAL_TITLE, "p.points > 0")
     settle(page)
     axes = page.evaluate(LOG_AXES_JS)
@@ -202,7 +202,7 @@ def test_a_warned_file_is_a_warning_in_every_tab_and_goes_with_its_data(page, ex
     repeats the warning as a warning (not as a refusal) and can diagnose them."""
     far = scaled(tmp_path, "paper_b_stiffness.csv", "thirty_times.csv", "magnitude", 30.0)
     open_tab(page, explorer_url)
-    page.locator("input[type=file]").first.set_input_files(str(far))
+    page.locator("#main input[type=file]").first.set_input_files(str(far))
     note = page.locator(".data-note:visible")
     expect(note).to_contain_text("thirty_times.csv: column magnitude")
     said = note.inner_text()
