@@ -38,6 +38,11 @@ in the diagnosis tab, whose widgets arrive with the tab and which draws no plot 
 paint sends a patch and hides it elsewhere). The page takes the models of each server patch as
 known: a model the page makes itself stays new.
 
+**Stylesheets from this server** (:func:`local_stylesheets`). Panel addresses its stylesheets
+against the document's ``dist_url`` (Bokeh's private ``Document._template_variables``), set only
+when the page is rendered; a component built before that and first sent after an upload asked
+the CDN for ``loading.css`` (a console error; nothing loaded offline). Set at session start.
+
 **MathJax.** Panel 1.9 sends Bokeh's MathJax bundle (1.8 MB, the largest script of the page) whenever the
 page holds an HTML pane, in case one holds math (holoviz/panel#8424; holoviz/panel#8179 would
 load it late instead). The explorer's texts hold none: the bundle is sent only to a page whose
@@ -112,7 +117,21 @@ def install(doc=None) -> None:
 
         doc.js_on_event("document_ready", CustomJS(code=BOKEHJS_SERVER_MODELS))
         doc.js_on_event("document_ready", CustomJS(code=LABEL_CLICKS))
+        local_stylesheets(doc)
         _pages.add(doc)
+
+
+def local_stylesheets(doc) -> None:
+    """Panel's stylesheets of every component of ``doc`` from this server, also of those built
+    before the page is rendered. Panel writes a component's stylesheet addresses against the
+    document's ``dist_url`` template variable (Bokeh's private ``Document._template_variables``),
+    which it sets only when it renders the page; until then it takes its CDN. A component built
+    with the session and first sent later (a measured-data tab's plots after an upload) then made
+    the page fetch ``loading.css`` from the CDN: a console error, and nothing loaded where the
+    server has no internet. Set here, before the session builds anything, to what Panel sets
+    at render (:func:`panel.io.resources.get_dist_path`: this server's path unless the resources
+    are the CDN)."""
+    doc._template_variables.setdefault("dist_url", panel_resources.get_dist_path())
 
 
 def send_values_at_once(classes) -> None:

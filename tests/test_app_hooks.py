@@ -92,3 +92,27 @@ def test_the_bokehjs_patches_go_into_a_page_once():
     callbacks = doc.callbacks._js_event_callbacks.get("document_ready", [])
     assert [c.code for c in callbacks] == [patches.BOKEHJS_PAINT_PATCHES, patches.BOKEHJS_SERVER_MODELS,
                                              patches.LABEL_CLICKS]
+
+
+def test_a_session_builds_its_stylesheets_from_this_server():
+    """A component built in a session before its page is rendered addresses Panel's stylesheets
+    on this server, not on the CDN (which a server without internet cannot reach; the page then
+    logged a console error after an upload). Fails if Bokeh's ``Document._template_variables``
+    goes, or if Panel stops addressing stylesheets by its ``dist_url``."""
+    import panel as pn
+    from bokeh.document import Document
+    from panel.io.state import set_curdoc
+    from panel.io.resources import CDN_DIST
+
+    from app import patches
+
+    def urls(doc):
+        with set_curdoc(doc):
+            model = pn.pane.HTML("x").get_root(doc)
+        return [s.url for s in model.stylesheets if hasattr(s, "url")]
+
+    assert any(u.startswith(CDN_DIST) for u in urls(Document()))  # Panel's own default, unrendered
+    doc = Document()
+    patches.install(doc)
+    shown = urls(doc)
+    assert shown and not any(u.startswith(("http:", "https:")) for u in shown), shown
