@@ -20,6 +20,7 @@ import param
 from core import PAPER_B, TABLE_1, Design
 from core.data import DataError, MeasuredLoop, MeasuredStiffness
 from core.io.measured import combined, parse_loop, parse_stiffness
+from core.numbers import rounded
 from core.parameters import MODE_TABLE, MODES
 from core.plausibility import loop_verdict, stiffness_column, stiffness_verdict
 
@@ -205,7 +206,8 @@ class ExplorerState(DesignFields, ToleranceBands):
         if problem:
             self.data_message = f"{filename}: {problem}; not loaded"
             return False
-        frequency, amplitude = float(np.clip(f, *FREQUENCY_BOUNDS)), float(f"{x:.4g}")
+        # the loop's own frequency and amplitude are estimates (0.09999999973 Hz): the quantities' digits
+        frequency, amplitude = rounded(float(np.clip(f, *FREQUENCY_BOUNDS)), 4), rounded(x, 4)
         moved = ""
         if (frequency, amplitude) != (self.frequency_hz, self.amplitude):
             moved = (f"{filename}: the operating point moved to the loop's {frequency:.4g} Hz and {amplitude:.4g} "

@@ -87,9 +87,18 @@ def format_value(value, unit: str = "", quantity: str | int | None = None) -> st
 
 
 def link_number(value) -> str:
-    """A number as a link writes it: :data:`LINK_DIGITS` significant digits, positional
-    (``0.1``, not ``0.09999999973330827`` nor ``1e-07``)."""
-    return _positional(float(value), LINK_DIGITS)
+    """A number as a link writes it, positional (never ``1e-07``): the shortest decimal that lies
+    as near the value as its rounding to :data:`LINK_DIGITS` significant digits may (half a unit
+    of that digit), so float noise goes (``0.1`` for ``0.09999999973330827``, as 9 digits alone
+    would keep ``0.0999999997``) and the value reads back to the same 9 digits' precision."""
+    value = float(value)
+    if not math.isfinite(value) or value == 0.0:
+        return _positional(value, LINK_DIGITS)
+    allowed = 0.5 * 10.0 ** (math.floor(math.log10(abs(value))) - LINK_DIGITS + 1)
+    for digits in range(1, LINK_DIGITS):
+        if abs(rounded(value, digits) - value) <= allowed:
+            return _positional(value, digits)
+    return _positional(value, LINK_DIGITS)
 
 
 def parse_number(text, what: str = "") -> float:

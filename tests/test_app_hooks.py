@@ -101,8 +101,8 @@ def test_a_session_builds_its_stylesheets_from_this_server():
     goes, or if Panel stops addressing stylesheets by its ``dist_url``."""
     import panel as pn
     from bokeh.document import Document
-    from panel.io.state import set_curdoc
     from panel.io.resources import CDN_DIST
+    from panel.io.state import set_curdoc
 
     from app import patches
 

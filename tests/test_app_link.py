@@ -3,6 +3,7 @@ gives each session. A link opened applies its good values and says which were no
 state's changes reach the address bar after a pause, one write for several quick changes; a
 value the URL already holds causes nothing."""
 
+from pathlib import Path
 from urllib.parse import parse_qsl
 
 import panel as pn
@@ -12,6 +13,9 @@ from bokeh.document import Document
 from app.link import URL_NAMES, design_query
 from app.main import URL_DELAY_MS, App
 from core import PAPER_B
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
 
 
 @pytest.fixture
@@ -147,3 +151,35 @@ def test_a_design_file_downloaded_opens_again_exactly(session):
     assert "geometry: missing (required)" in opener.message.object and s.design == shown
     assert opener.load(dumps_design(PAPER_B.in_mode("torsion")), "t.json")  # another mode: mid-range amplitude
     assert s.design.mode == "torsion" and s.errors == {}
+
+
+def test_a_link_number_is_the_shortest_within_nine_digits():
+    """A link's number reads back as near its value as nine significant digits do (half a unit
+    of the ninth), in the fewest digits that do: float noise goes."""
+    import math
+
+    import numpy as np
+
+    from core.numbers import LINK_DIGITS, link_number
+
+    rng = np.random.default_rng(7)
+    for v in [*(10.0 ** rng.uniform(-9, 9, 300) * rng.choice([-1, 1], 300)), 0.30000000000000004, 40.0]:
+        text = link_number(v)
+        half = 0.5 * 10.0 ** (math.floor(math.log10(abs(v))) - LINK_DIGITS + 1)
+        assert abs(float(text) - v) <= half * (1 + 1e-9), (v, text)
+        assert "e" not in text.lower()
+        digits = len(text.lstrip("-").replace(".", "").strip("0"))
+        assert digits <= LINK_DIGITS
+    assert link_number(0.30000000000000004) == "0.3" and link_number(40.0) == "40"
+
+
+def test_a_loop_upload_moves_the_operating_point_to_round_numbers():
+    """The loop's frequency is estimated from its samples (0.09999999973 Hz for the example's
+    0.1 Hz): the operating point and its link take the quantity's four digits."""
+    from app.link import url_query
+    from app.state import ExplorerState
+
+    s = ExplorerState()
+    assert s.load_measured_loop((EXAMPLES / "paper_b_loop.csv").read_text(), "paper_b_loop.csv")
+    query = url_query(s)
+    assert query["f_Hz"] == "0.1", query
