@@ -100,7 +100,7 @@ class ExportView(pn.viewable.Viewer):
             pn.pane.Markdown(
                 "Share: the link (the address bar) holds what the page shows: the design with its "
                 "effects, the pinned reference, the operating point and the bands. The design file "
-                "opens again with **Open a design file**, above the mode. PNG: the save icon in each plot's toolbar.",
+                "opens again with **Open a design file**, just above. PNG: the save icon in each plot's toolbar.",
                 sizing_mode="stretch_width", styles={"font-size": "0.9em"}),
             sizing_mode="stretch_width",
         )

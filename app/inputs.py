@@ -194,7 +194,6 @@ class DesignInputs(pn.viewable.Viewer):
         material = [self._field(n) for n in MATERIAL_FIELDS]
         return pn.Column(
             self.preset,
-            self.design_file,
             self.mode,
             error_text(self.state, "mode"),
             self.finite_length,
@@ -208,6 +207,7 @@ class DesignInputs(pn.viewable.Viewer):
             pn.Card(*material, title="Material", collapsed=False, sizing_mode="stretch_width"),
             pn.Card(self._field("freq_min"), self._field("freq_max"), title="Frequency sweep",
                     sizing_mode="stretch_width"),
+            self.design_file,  # beside Export and share, which saves it: the inputs first at 720 px
             sizing_mode="stretch_width",
         )
 

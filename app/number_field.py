@@ -53,8 +53,11 @@ class NumberField(pn.viewable.Viewer):
         self.blank = p.allow_None if blank is None else blank
         self.input = NumberText(label=self.label(), value=self.shown(getattr(obj, name)),
                                 description=p.doc, css_classes=["number-field"], **widget)
-        self.message = pn.pane.HTML("", margin=(0, 10, 4, 10), sizing_mode="stretch_width",
-                                    styles={"color": "#b03a2e", "font-size": "0.9em"})
+        # as wide as the field: a fixed-width field stays fixed (a stretching message made the
+        # field's column take a whole row of a FlexBox)
+        size = {"width": widget["width"]} if widget.get("width") else {"sizing_mode": "stretch_width"}
+        self.message = pn.pane.HTML("", margin=(0, 10, 4, 10), styles={"color": "#b03a2e", "font-size": "0.9em"},
+                                    **size)
         self.input.param.watch(self._typed, "value")
         obj.param.watch(self._set_elsewhere, name)
 

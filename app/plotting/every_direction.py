@@ -5,7 +5,7 @@ from __future__ import annotations
 import holoviews as hv
 
 from core import Design
-from core.parameters import MODE, ROTATIONS, TRANSLATIONS
+from core.parameters import ROTATIONS, TRANSLATIONS
 
 from .. import curves
 from ..shapes import card_basis
@@ -22,8 +22,9 @@ from .style import (
 
 
 def direction_title(mode: str) -> str:
-    """The title of a direction's |K| plot: "|K| axial: the sleeves moved apart along the axis"."""
-    return f"|K| {mode}: {MODE[mode].description}"
+    """The title of a direction's |K| plot: "|K| axial" (the tab's text says what each direction
+    moves; a longer title was cut in a half-width plot at 1280 px)."""
+    return f"|K| {mode}"
 
 
 def card_dimensions() -> dict[str, hv.Dimension]:

@@ -38,7 +38,7 @@ HOW_TO = """**No measured data loaded yet.** To fit this bushing's material:
 1. Drop a **stiffness CSV** above: one row per point, `frequency_hz,amplitude,magnitude,loss_factor` (Hz, m or rad,
    N/m or N·m/rad; or `stiffness_real,stiffness_imag`, an optional `mode` column; docs/files.md, About tab).
 2. Optionally a **loop CSV**: `time_s,displacement,force` (s, m or rad, N or N·m).
-3. Press **Fit**.
+3. Press **Fit the five material parameters**.
 
 No file at hand? Press *Load the synthetic Paper B example*, or try the files in the repository's `examples/`
 folder: `paper_b_stiffness.csv` with `paper_b_loop.csv` (Paper B preset, axial), `table1_torsion_stiffness.csv`
@@ -75,7 +75,7 @@ class MeasuredView(PlotView):
         self.fit_button.on_click(self._fit)
         self.method = pn.widgets.RadioButtonGroup.from_param(fit.param.fit_method, description=fit.param.fit_method.doc)
         self.fit_on = pn.widgets.TextInput.from_param(fit.param.fit_on, description=fit.param.fit_on.doc,
-                                                      placeholder="mode=axial,amplitude=0.1", max_length=500,
+                                                      placeholder="e.g. mode=axial,amplitude=0.1 (amplitudes in mm or rad)", max_length=500,
                                                       sizing_mode="stretch_width")
         self.sweep = pn.widgets.Select(label="Sweep amplitude (two-step)", options={}, sizing_mode="stretch_width",
                                        description=fit.param.sweep_amplitude.doc)

@@ -147,7 +147,7 @@ def test_every_direction_from_a_link(page, explorer_url):
     page.get_by_text("Every direction", exact=True).click()
     page.get_by_text("Shape factor: finite-length table, every direction.").wait_for()
     page.get_by_text("Ratios").wait_for()
-    axial, radial = "|K| axial: the sleeves moved apart along the axis", "|K| radial: the sleeves moved apart across the axis"
+    axial, radial = "|K| axial", "|K| radial"
     for title in (axial, radial, "Loss factor, turning and tilting"):
         wait_plot(page, title, "p.points > 0")
     shown = plots(page)
