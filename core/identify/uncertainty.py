@@ -44,7 +44,10 @@ LONGEST_STEP = 1 / 10  # steps double up to this fraction of the range
 # doubling from the least first step reaches the longest step in 17 steps, which then reach the
 # end of the range in at most 10 more: a side never needs more
 MAX_STEPS = math.ceil(math.log2(LONGEST_STEP / FIRST_STEP[0])) + round(1 / LONGEST_STEP) + 1
-BISECTIONS = 4  # refinements of a crossing
+BISECTIONS = 4  # refinements of a crossing, at most
+# a crossing is found when the signed root of the rise is within this fraction of the threshold's
+# root: the interval's end then within about a thousandth of its distance from the optimum
+CROSSING_TOLERANCE = 1e-3
 # a refit's iterations in the stages of minimise (evaluations, the Jacobian's not counted): a
 # warm-started refit of these models converges in fewer than 20 trf iterations, or stalls
 REFIT_NFEV = (20, 40, 100)
@@ -260,22 +263,35 @@ class _Walker:
         return None
 
     def _crossing(self, j, inner, outer, x_hat) -> float:
-        """Bisect between a point inside and one outside, then interpolate the signed root
-        sqrt(rise), which is linear in a parameter the model is linear in. The side's evaluations
-        spent during the bisection end it: the crossing is interpolated in the bracket reached."""
-        (a, xa, ra), (b, _, rb) = inner, outer
+        """Refine a bracket (a point inside, one outside) by regula falsi on the signed root
+        g = sqrt(rise) − sqrt(threshold), which is linear in a parameter the model is linear in:
+        each refit is at the bracket's root of g (the Illinois rule halving a side's g that
+        stays twice, so that a curved profile still shrinks the bracket from both sides), the
+        others started between their values at the ends. At most :data:`BISECTIONS` refits; done
+        when g is within :data:`CROSSING_TOLERANCE` of the threshold's root. Then the root of g
+        interpolated in the bracket reached. The side's evaluations spent during it end it too."""
+        (a, xa, ra), (b, xb, rb) = inner, outer
+        root_t = math.sqrt(self.threshold)
+        ga, gb = math.sqrt(ra) - root_t, math.sqrt(rb) - root_t
+        kept = 0  # which end stayed at the last refit: -1 the inner, +1 the outer
         for _ in range(BISECTIONS):
-            mid = 0.5 * (a + b)
+            w = float(np.clip(-ga / (gb - ga), 0.0, 1.0)) if gb > ga else 0.5
+            mid = a + (b - a) * w
             try:
-                s, x = self.refit(j, mid, [xa, x_hat])
+                s, x = self.refit(j, mid, [xa + (xb - xa) * w, x_hat])
             except _Exhausted:
                 break
-            rise = s - self.s_min
-            if rise > self.threshold:
-                b, rb = mid, rise
+            g = math.sqrt(max(s - self.s_min, 0.0)) - root_t
+            if g > 0:
+                b, xb, gb = mid, x, g
+                ga, kept = (0.5 * ga if kept == -1 else ga), -1
             else:
-                a, xa, ra = mid, x, max(rise, 0.0)
-        root_a, root_b, root_t = math.sqrt(ra), math.sqrt(rb), math.sqrt(self.threshold)
+                a, xa, ga = mid, x, g
+                gb, kept = (0.5 * gb if kept == 1 else gb), 1
+            if abs(g) <= CROSSING_TOLERANCE * root_t:
+                break
+        ra, rb = (max(ga + root_t, 0.0) ** 2, (gb + root_t) ** 2)  # the rises the (halved) roots stand for
+        root_a, root_b = math.sqrt(ra), math.sqrt(rb)
         if root_b <= root_a:
             return b
         return a + (b - a) * (root_t - root_a) / (root_b - root_a)
