@@ -274,7 +274,7 @@ def _profiled(problem: _Problem, sol):
     lo, hi = problem.bounds()
     for _ in range(3):
         sd = _uncertainties(problem, sol)[2]
-        prof = profile(problem.residuals, sol.x, lo, hi, sd, jacobian=sol.jac)
+        prof = profile(problem.residuals, sol.x, lo, hi, sd)
         if prof.better is None:
             break
         moved = _solve(problem, [prof.better])

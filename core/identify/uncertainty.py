@@ -19,7 +19,8 @@ residual function of all of them, with their bounds.
 
 The work is bounded by counts, never by the clock, so that a result does not depend on the
 machine: a side takes at most :data:`MAX_STEPS` outward steps (enough to reach the end of the
-fitting range from the smallest first step) and :data:`BISECTIONS` refinements; a refit at most
+fitting range from the smallest first step) and :data:`SECANTS` interpolations, then if need be
+:data:`BISECTIONS` refinements, of its crossing; a refit at most
 :data:`REFIT_NFEV` iterations; and a side at most :data:`SIDE_EVALUATIONS` evaluations of the
 residuals. A side that spends them before it crosses the threshold is left open, and the
 profile says it is not complete.
@@ -44,10 +45,11 @@ LONGEST_STEP = 1 / 10  # steps double up to this fraction of the range
 # doubling from the least first step reaches the longest step in 17 steps, which then reach the
 # end of the range in at most 10 more: a side never needs more
 MAX_STEPS = math.ceil(math.log2(LONGEST_STEP / FIRST_STEP[0])) + round(1 / LONGEST_STEP) + 1
-BISECTIONS = 4  # refinements of a crossing, at most
-# a crossing is found when the signed root of the rise is within this fraction of the threshold's
-# root: the interval's end then within about a thousandth of its distance from the optimum
+BISECTIONS = 4  # refinements of a crossing
+# a crossing is found where the signed root of the rise is within this fraction of the threshold's
+# root: the interval's end within about a thousandth of its distance from the optimum
 CROSSING_TOLERANCE = 1e-3
+SECANTS = 2  # refits that try to meet a crossing by interpolation before bisecting
 # a refit's iterations in the stages of minimise (evaluations, the Jacobian's not counted): a
 # warm-started refit of these models converges in fewer than 20 trf iterations, or stalls
 REFIT_NFEV = (20, 40, 100)
@@ -140,13 +142,11 @@ def linearised(jac: np.ndarray, sum_of_squares: float, names, values: dict[str, 
 
 
 def profile(residuals: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, lower, upper,
-            step, *, confidence: float = CONFIDENCE, evaluations: int = SIDE_EVALUATIONS,
-            jacobian: np.ndarray | None = None) -> Profile:
+            step, *, confidence: float = CONFIDENCE, evaluations: int = SIDE_EVALUATIONS) -> Profile:
     """Profile every parameter of the least-squares problem ``residuals`` about its optimum
     ``theta`` within the bounds; ``step`` gives each parameter's first step (for example its
     linearised standard error, in the same coordinates). At most ``evaluations`` evaluations of
-    ``residuals`` per side, and one at the optimum. ``jacobian``, that of ``residuals`` at
-    ``theta`` if known, starts each side's first refit where the others move to first order."""
+    ``residuals`` per side, and one at the optimum."""
     theta = np.asarray(theta, dtype=float)
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     r0 = residuals(theta)
@@ -155,7 +155,7 @@ def profile(residuals: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, lo
     dof = max(n - p, 1)
     s2 = max(s_min / dof, NOISE_FLOOR**2)
     threshold = s2 * float(f_distribution.ppf(confidence, 1, dof))
-    walker = _Walker(residuals, theta, lower, upper, s_min, threshold, _slopes(jacobian, p))
+    walker = _Walker(residuals, theta, lower, upper, s_min, threshold)
     intervals, complete = [], True
     for j in range(p):
         sides = []
@@ -170,28 +170,14 @@ def profile(residuals: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, lo
     return Profile(intervals, walker.better, threshold, complete, walker.spent + 1)
 
 
-def _slopes(jacobian: np.ndarray | None, p: int) -> np.ndarray:
-    """Row j: how the other parameters move, to first order, per unit of parameter j held away
-    from the optimum (the least-squares solution of J_others · dx = −J_j); zeros without a
-    usable Jacobian."""
-    slopes = np.zeros((p, max(p - 1, 0)))
-    if jacobian is None or p < 2 or not np.all(np.isfinite(jacobian)):
-        return slopes
-    for j in range(p):
-        others = np.arange(p) != j
-        slopes[j] = np.linalg.lstsq(jacobian[:, others], -jacobian[:, j], rcond=None)[0]
-    return slopes
-
-
 def _first_step(step: float, span: float) -> float:
     step = abs(float(step)) if math.isfinite(step) else span
     return float(np.clip(step, span * FIRST_STEP[0], span * FIRST_STEP[1]))
 
 
 class _Walker:
-    def __init__(self, residuals, theta, lower, upper, s_min, threshold, slopes):
+    def __init__(self, residuals, theta, lower, upper, s_min, threshold):
         self.residuals, self.theta, self.lower, self.upper = residuals, theta, lower, upper
-        self.slopes = slopes
         self.s_min, self.threshold = s_min, threshold
         self.better: np.ndarray | None = None
         self.best_s = s_min
@@ -261,7 +247,6 @@ class _Walker:
         edge = self.lower[j] if direction < 0 else self.upper[j]
         span = self.upper[j] - self.lower[j]
         inside, x_in, rise_in = float(self.theta[j]), x_hat, 0.0
-        before = None  # the point inside before ``inside``: the others' slope along the profile
         for _ in range(MAX_STEPS):
             if abs(edge - inside) <= 1e-12 * max(span, 1.0):
                 return None  # the optimum sits at the bound: nothing beyond it to test
@@ -269,17 +254,10 @@ class _Walker:
             at_edge = direction * (value - edge) >= 0
             if at_edge:
                 value = edge
-            # the others started on the line through the last two points inside (the profile's
-            # path is smooth: fewer iterations than from the last point)
-            if before is None:
-                x0 = x_in + self.slopes[j] * (value - inside)
-            else:
-                x0 = x_in + (x_in - before[1]) * (value - inside) / (inside - before[0])
-            s, x = self.refit(j, value, [x0, x_hat])
+            s, x = self.refit(j, value, [x_in, x_hat])
             rise = s - self.s_min
             if rise > self.threshold:
                 return self._crossing(j, (inside, x_in, rise_in), (value, x, rise), x_hat)
-            before = (inside, x_in)
             inside, x_in, rise_in = value, x, max(rise, 0.0)
             if at_edge:
                 return None
@@ -287,35 +265,47 @@ class _Walker:
         return None
 
     def _crossing(self, j, inner, outer, x_hat) -> float:
-        """Refine a bracket (a point inside, one outside) by regula falsi on the signed root
-        g = sqrt(rise) − sqrt(threshold), which is linear in a parameter the model is linear in:
-        each refit is at the bracket's root of g (the Illinois rule halving a side's g that
-        stays twice, so that a curved profile still shrinks the bracket from both sides), the
-        others started between their values at the ends. At most :data:`BISECTIONS` refits; done
-        when g is within :data:`CROSSING_TOLERANCE` of the threshold's root. Then the root of g
-        interpolated in the bracket reached. The side's evaluations spent during it end it too."""
-        (a, xa, ra), (b, xb, rb) = inner, outer
+        """Where the profile crosses the threshold between a point inside and one outside.
+
+        First up to :data:`SECANTS` refits where the signed root g = sqrt(rise) −
+        sqrt(threshold), linear in a parameter the model is linear in, is interpolated to vanish
+        (regula falsi, the bracket narrowed by each): where g comes within
+        :data:`CROSSING_TOLERANCE` of the threshold's root, that is the crossing (a smooth
+        profile: one or two refits, not :data:`BISECTIONS`). Otherwise (a curved profile, as at
+        a cliff) bisect the bracket as first given, then interpolate the signed root in the
+        bracket reached. The side's evaluations spent meanwhile end it: the crossing is
+        interpolated in the bracket reached."""
         root_t = math.sqrt(self.threshold)
-        ga, gb = math.sqrt(ra) - root_t, math.sqrt(rb) - root_t
-        kept = 0  # which end stayed at the last refit: -1 the inner, +1 the outer
-        for _ in range(BISECTIONS):
-            w = float(np.clip(-ga / (gb - ga), 0.0, 1.0)) if gb > ga else 0.5
-            mid = a + (b - a) * w
+        (a, xa, ra), (b, _, rb) = inner, outer
+        root_a, root_b = math.sqrt(ra), math.sqrt(rb)
+        for _ in range(SECANTS):
+            if root_b <= root_a:
+                break
+            guess = a + (b - a) * (root_t - root_a) / (root_b - root_a)
             try:
-                s, x = self.refit(j, mid, [xa + (xb - xa) * w, x_hat])
+                s, x = self.refit(j, guess, [xa, x_hat])
+            except _Exhausted:
+                return guess
+            root = math.sqrt(max(s - self.s_min, 0.0))
+            if abs(root - root_t) <= CROSSING_TOLERANCE * root_t:
+                return guess
+            if root > root_t:
+                b, root_b = guess, root
+            else:
+                a, xa, root_a = guess, x, root
+        (a, xa, ra), (b, _, rb) = inner, outer
+        for _ in range(BISECTIONS):
+            mid = 0.5 * (a + b)
+            try:
+                s, x = self.refit(j, mid, [xa, x_hat])
             except _Exhausted:
                 break
-            g = math.sqrt(max(s - self.s_min, 0.0)) - root_t
-            if g > 0:
-                b, xb, gb = mid, x, g
-                ga, kept = (0.5 * ga if kept == -1 else ga), -1
+            rise = s - self.s_min
+            if rise > self.threshold:
+                b, rb = mid, rise
             else:
-                a, xa, ga = mid, x, g
-                gb, kept = (0.5 * gb if kept == 1 else gb), 1
-            if abs(g) <= CROSSING_TOLERANCE * root_t:
-                break
-        ra, rb = (max(ga + root_t, 0.0) ** 2, (gb + root_t) ** 2)  # the rises the (halved) roots stand for
-        root_a, root_b = math.sqrt(ra), math.sqrt(rb)
+                a, xa, ra = mid, x, max(rise, 0.0)
+        root_a, root_b, root_t = math.sqrt(ra), math.sqrt(rb), math.sqrt(self.threshold)
         if root_b <= root_a:
             return b
         return a + (b - a) * (root_t - root_a) / (root_b - root_a)
