@@ -19,7 +19,8 @@ residual function of all of them, with their bounds.
 
 The work is bounded by counts, never by the clock, so that a result does not depend on the
 machine: a side takes at most :data:`MAX_STEPS` outward steps (enough to reach the end of the
-fitting range from the smallest first step) and :data:`BISECTIONS` refinements; a refit at most
+fitting range from the smallest first step) and :data:`SECANTS` interpolations, then if need be
+:data:`BISECTIONS` refinements, of its crossing; a refit at most
 :data:`REFIT_NFEV` iterations; and a side at most :data:`SIDE_EVALUATIONS` evaluations of the
 residuals. A side that spends them before it crosses the threshold is left open, and the
 profile says it is not complete.
@@ -45,6 +46,10 @@ LONGEST_STEP = 1 / 10  # steps double up to this fraction of the range
 # end of the range in at most 10 more: a side never needs more
 MAX_STEPS = math.ceil(math.log2(LONGEST_STEP / FIRST_STEP[0])) + round(1 / LONGEST_STEP) + 1
 BISECTIONS = 4  # refinements of a crossing
+# a crossing is found where the signed root of the rise is within this fraction of the threshold's
+# root: the interval's end within about a thousandth of its distance from the optimum
+CROSSING_TOLERANCE = 1e-3
+SECANTS = 2  # refits that try to meet a crossing by interpolation before bisecting
 # a refit's iterations in the stages of minimise (evaluations, the Jacobian's not counted): a
 # warm-started refit of these models converges in fewer than 20 trf iterations, or stalls
 REFIT_NFEV = (20, 40, 100)
@@ -260,9 +265,34 @@ class _Walker:
         return None
 
     def _crossing(self, j, inner, outer, x_hat) -> float:
-        """Bisect between a point inside and one outside, then interpolate the signed root
-        sqrt(rise), which is linear in a parameter the model is linear in. The side's evaluations
-        spent during the bisection end it: the crossing is interpolated in the bracket reached."""
+        """Where the profile crosses the threshold between a point inside and one outside.
+
+        First up to :data:`SECANTS` refits where the signed root g = sqrt(rise) −
+        sqrt(threshold), linear in a parameter the model is linear in, is interpolated to vanish
+        (regula falsi, the bracket narrowed by each): where g comes within
+        :data:`CROSSING_TOLERANCE` of the threshold's root, that is the crossing (a smooth
+        profile: one or two refits, not :data:`BISECTIONS`). Otherwise (a curved profile, as at
+        a cliff) bisect the bracket as first given, then interpolate the signed root in the
+        bracket reached. The side's evaluations spent meanwhile end it: the crossing is
+        interpolated in the bracket reached."""
+        root_t = math.sqrt(self.threshold)
+        (a, xa, ra), (b, _, rb) = inner, outer
+        root_a, root_b = math.sqrt(ra), math.sqrt(rb)
+        for _ in range(SECANTS):
+            if root_b <= root_a:
+                break
+            guess = a + (b - a) * (root_t - root_a) / (root_b - root_a)
+            try:
+                s, x = self.refit(j, guess, [xa, x_hat])
+            except _Exhausted:
+                return guess
+            root = math.sqrt(max(s - self.s_min, 0.0))
+            if abs(root - root_t) <= CROSSING_TOLERANCE * root_t:
+                return guess
+            if root > root_t:
+                b, root_b = guess, root
+            else:
+                a, xa, root_a = guess, x, root
         (a, xa, ra), (b, _, rb) = inner, outer
         for _ in range(BISECTIONS):
             mid = 0.5 * (a + b)

@@ -1,0 +1,83 @@
+"""The work of a diagnosis, counted (issue #27, item 16): the diagnosis of the 150 points the
+browser benchmark uploads stays within a count of model evaluations (counts, not seconds: they
+do not depend on the machine's load), and the profile's cheaper crossing search still finds the
+crossing a fine search finds."""
+
+import functools
+import math
+
+import numpy as np
+import pytest
+from scipy import optimize, stats
+
+import core.identify.fit as fit_module
+from core import PAPER_B
+from core.identify.diagnose import diagnose
+from core.identify.uncertainty import CROSSING_TOLERANCE, profile
+from core.synthetic import synthetic_stiffness
+
+# the model evaluations (stiffness_points calls of the fits) of the 150-point diagnosis: 10,563
+# before the profile's crossings were interpolated (the final profile 3,242 of them), 9,605 after
+# (2,284)
+MAX_EVALUATIONS = 9_900
+MAX_PROFILE_EVALUATIONS = 2_600
+
+
+def test_the_150_point_diagnosis_stays_within_its_count_of_model_evaluations(monkeypatch):
+    hidden = PAPER_B.replace(effects={"inertia": {"mass": 0.5}})
+    data = synthetic_stiffness(hidden, np.linspace(1, 100, 30), [0.013e-3, 0.04e-3, 0.1e-3, 0.17e-3, 0.35e-3],
+                               noise=0.005, seed=3)  # benchmarks/diagnose_browser.py's file
+    counts: dict[str, int] = {}
+    stage = ["start"]
+    original = fit_module.stiffness_points
+
+    def counted(*args, **kwargs):
+        counts[stage[0]] = counts.get(stage[0], 0) + 1
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(fit_module, "stiffness_points", counted)
+    result = diagnose(PAPER_B, data, progress=lambda _f, message: stage.__setitem__(0, message))
+
+    assert result.added == ["inertia"]  # the work counted is that of the right answer
+    step = result.steps[0]
+    assert abs(step.parameters["mass"] - 0.5) < 3 * step.standard_errors["mass"]
+    assert counts["profiling the final model's parameters"] <= MAX_PROFILE_EVALUATIONS
+    assert sum(counts.values()) <= MAX_EVALUATIONS
+
+
+def test_the_profile_crossing_is_where_a_fine_search_puts_it():
+    """y = a·exp(−b·x) + noise (nonlinear in b): each end of each profile interval against the
+    root of the profile's rise minus the threshold found by Brent's method on exact refits."""
+    rng = np.random.default_rng(11)
+    x = np.linspace(0.0, 4.0, 30)
+    y = 2.0 * np.exp(-0.8 * x) + 0.05 * rng.standard_normal(x.size)
+
+    def residuals(theta):
+        return theta[0] * np.exp(-theta[1] * x) - y
+
+    fit = optimize.least_squares(residuals, [1.0, 1.0], xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    s_min = float(fit.fun @ fit.fun)
+    threshold = s_min / (x.size - 2) * stats.f.ppf(0.95, 1, x.size - 2)
+    sd = np.sqrt(np.diag(np.linalg.inv(fit.jac.T @ fit.jac)) * s_min / (x.size - 2))
+
+    prof = profile(residuals, fit.x, [-10.0, -10.0], [10.0, 10.0], sd)
+
+    def rise(j, value):  # the profile exactly: the other parameter refitted from the optimum
+        other = 1 - j
+
+        def r(free):
+            theta = np.empty(2)
+            theta[j], theta[other] = value, free[0]
+            return residuals(theta)
+
+        sol = optimize.least_squares(r, [fit.x[other]], xtol=1e-15, ftol=1e-15, gtol=1e-15)
+        return float(sol.fun @ sol.fun) - s_min - threshold
+
+    assert prof.complete and prof.better is None
+    for j, (lo, hi) in enumerate(prof.intervals):
+        for end, outward in ((lo, -1.0), (hi, 1.0)):
+            truth = optimize.brentq(functools.partial(rise, j), fit.x[j], fit.x[j] + outward * 10 * sd[j], xtol=1e-14)
+            # g = sqrt(rise) − sqrt(threshold) within the tolerance: the end within about that
+            # fraction of its distance from the optimum
+            assert end == pytest.approx(truth, abs=3 * CROSSING_TOLERANCE * abs(truth - fit.x[j]))
+            assert not math.isclose(end, fit.x[j])
