@@ -196,3 +196,20 @@ def test_a_readme_command_prints_what_the_readme_shows(command, shown, workdir):
     for option, name in itertools.pairwise(argv):
         if option in ("-o", "--json", "--predictions"):
             check_written(workdir / name)
+
+
+def test_the_readme_shows_a_screenshot_of_every_tab():
+    """Every picture the README shows is in the repository, a 1280×720 PNG, and there is one per
+    tab of the explorer, named after it, in the tabs' order."""
+    import struct
+
+    from app.main import App
+
+    text = (ROOT / "README.md").read_text()
+    pictures = re.findall(r"!\[([^\]]*)\]\(([^)]+)\)", text)
+    titles = ["Explorer", *(title for title, _name, _build in App.LAZY_TABS), "About"]
+    assert [alt for alt, _path in pictures] == titles
+    for _alt, path in pictures:
+        head = (ROOT / path).read_bytes()[:24]
+        assert head[:8] == b"\x89PNG\r\n\x1a\n", path
+        assert struct.unpack(">II", head[16:24]) == (1280, 720), path
