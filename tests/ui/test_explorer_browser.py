@@ -66,7 +66,7 @@ def test_tap_moves_the_operating_point_in_every_plot(page, explorer_url):
     f_k = p["|K| against frequency"]["spans"][0]
     f_eta = p["Loss factor against frequency"]["spans"][0]
     assert f_k == pytest.approx(f_eta) and 20 < f_k < 100
-    expect(page.locator(".op-point")).to_contain_text(f"{f_k:.3g} Hz")
+    expect(page.locator(".op-point")).to_contain_text(f"{f_k:.4g} Hz")  # a frequency's four digits
     # the address bar follows (its update is the change's last message), then the page rests
     # (the link is written when the page opens, at 10 Hz: wait for the tap's frequency)
     page.wait_for_url(lambda url: re.search(r"f_Hz=([0-9.e+-]+)", url).group(1) != "10")
