@@ -42,6 +42,7 @@ import numpy as np
 import panel as pn
 
 from . import patches
+from .plotting.style import style_key
 
 log = logging.getLogger("bushing.app")
 
@@ -75,17 +76,20 @@ def _same_data(a: hv.Element, b: hv.Element) -> bool:
 
 
 def _shape(overlay) -> tuple | None:
-    """What HoloViews builds a plot from, numbers aside: each element's kind, key, style (its
-    options' id: the elements are clones of styled templates) and dimensions (names, labels,
-    units). Two frames of one shape differ in their numbers only (data, ranges, a marker)."""
+    """What HoloViews builds a plot from, numbers and words aside: each element's kind, key,
+    style (:func:`app.plotting.style.style_key`: the elements are clones of styled templates) and
+    dimension names. Two frames of one shape differ in their numbers (data, ranges, a marker) and
+    in the words of their dimensions only (labels and units, after a mode switch: the axis labels
+    and the tooltips' words)."""
     if not isinstance(overlay, hv.Overlay):
         return None
-    return tuple((type(el), key, el.id, tuple((d.name, d.label, d.unit) for d in el.dimensions()))
+    return tuple((type(el), key, style_key(el), tuple(d.name for d in el.dimensions()))
                  for key, el in overlay.data.items())
 
 
 def same_shape(old, new) -> bool:
-    """Whether overlays ``old`` and ``new`` differ in their numbers only (:func:`_shape`)."""
+    """Whether overlays ``old`` and ``new`` differ in their numbers and dimension words only
+    (:func:`_shape`)."""
     shape = _shape(old)
     return shape is not None and shape == _shape(new)
 

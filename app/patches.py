@@ -310,6 +310,44 @@ def _element_data(subplot, element) -> dict | None:
     return data
 
 
+def _words(old, new) -> dict | None:
+    """Each dimension label (with its unit, as HoloViews prints it) of overlay ``old`` → that of
+    the dimension of the same name at the same place in ``new``; None if one label would become
+    two."""
+    out = {}
+    for a, b in zip(old.values(), new.values()):
+        for da, db in zip(a.dimensions(), b.dimensions()):
+            if da.name != db.name or out.setdefault(da.pprint_label, db.pprint_label) != db.pprint_label:
+                return None
+    return out
+
+
+def _labels_written(plot, was: tuple, now: tuple, words: dict | None) -> list | None:
+    """The writes that put the words of dimensions ``now`` (x, y) where HoloViews drew those of
+    ``was``: the axis labels and the hover tooltips' labels (:data:`app.plotting.style.CURVE_TIP`
+    and one ``(label, "@{name}")`` per dimension). None if the plot's axes or tooltips do not
+    show ``was`` as expected (then HoloViews must draw the new words itself)."""
+    if words is None:
+        return None
+    writes = []
+    for handle, before, after in zip(("xaxis", "yaxis"), was, now):
+        axis = plot.handles.get(handle)
+        if axis is None or getattr(axis, "axis_label", None) != before.pprint_label:
+            return None
+        if after.pprint_label != before.pprint_label:
+            writes.append((axis, {"axis_label": after.pprint_label}))
+    for tool in plot.state.toolbar.tools:
+        if tool.__class__.__name__ != "HoverTool":
+            continue
+        tips = tool.tooltips
+        if not isinstance(tips, list) or not all(isinstance(t, tuple) and len(t) == 2 for t in tips):
+            return None
+        renamed = [(words.get(label, label), field) for label, field in tips]
+        if renamed != list(tips):
+            writes.append((tool, {"tooltips": renamed}))
+    return writes
+
+
 def written(plot, old, new):
     """A function that writes the numbers of overlay ``new`` into ``plot`` (HoloViews' plot of the
     overlay ``old``, the same elements with other numbers), the elements that are ``old``'s own
@@ -333,14 +371,20 @@ def written(plot, old, new):
         if data is None:
             return None
         writes.append((sub.handles["source"], {"data": data}))
-    first = next((el for el in new.values() if el.__class__.__name__ not in ("VLine", "HLine")), None)
-    if first is not None:
+    index = next((i for i, el in enumerate(new.values()) if el.__class__.__name__ not in ("VLine", "HLine")), None)
+    if index is not None:
+        first, was = new.values()[index], old.values()[index]
         for axis, dim in (("x_range", first.kdims[0]), ("y_range", first.vdims[0])):
             rng, model = _axis_range(dim), plot.handles.get(axis)
             if rng is None or model is None or not hasattr(model, "start"):
                 return None
             if (model.start, model.end) != rng:
                 writes.append((model, {"start": rng[0], "end": rng[1]}))
+        labels = _labels_written(plot, (was.kdims[0], was.vdims[0]), (first.kdims[0], first.vdims[0]),
+                                 _words(old, new))
+        if labels is None:
+            return None
+        writes += labels
 
     def write():
         for model, values in writes:
