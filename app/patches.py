@@ -285,8 +285,9 @@ def install_bokehjs_patches(doc):
 
 def holoviews_plots(pane) -> list:
     """The HoloViews plots a Panel HoloViews pane has rendered (one per page showing it; none before
-    it is shown)."""
-    return [plot for plot, _model in getattr(pane, "_plots", {}).values()]
+    it is shown), each once (Panel files a plot under each root model it is rendered in: a page's
+    template and the pane's own root)."""
+    return list({id(plot): plot for plot, _model in getattr(pane, "_plots", {}).values()}.values())
 
 
 def _axis_range(dim) -> tuple[float, float] | None:
