@@ -63,7 +63,8 @@ a change sets arrives in one message and is painted at once.
 (kinds, labels, styles, dimensions) differs only in its numbers, and those are written into the
 Bokeh models HoloViews made: each changed element's columns (HoloViews' own ``get_data`` makes
 them) into its glyph's data source, a marker's position into its span, the frame's axis ranges
-into the figure's ranges. HoloViews' per-update path (ranges, styles, legends and axes of every
+into the figure's ranges (and the Reset tool's), the words of its dimensions (labels and units,
+new after a mode switch) into the axis labels and the hover tooltips. HoloViews' per-update path (ranges, styles, legends and axes of every
 subplot recomputed) is skipped. Measured on the explorer with ``benchmarks/explorer_change.py``
 (30 changes, medians): server CPU per amplitude change 82 ms before this hook, 31 ms with it. Panel keeps a pane's HoloViews plots in the private
 ``HoloViews._plots`` (one per root model); the plot's ``subplots``, ``handles`` and
@@ -379,8 +380,9 @@ def written(plot, old, new):
             rng, model = _axis_range(dim), plot.handles.get(axis)
             if rng is None or model is None or not hasattr(model, "start"):
                 return None
-            if (model.start, model.end) != rng:
-                writes.append((model, {"start": rng[0], "end": rng[1]}))
+            if (model.start, model.end) != rng or (getattr(model, "reset_start", None), getattr(model, "reset_end", None)) != rng:
+                # and where the Reset tool returns to, as HoloViews sets it (else the first frame's range)
+                writes.append((model, {"start": rng[0], "end": rng[1], "reset_start": rng[0], "reset_end": rng[1]}))
         labels = _labels_written(plot, (was.kdims[0], was.vdims[0]), (first.kdims[0], first.vdims[0]),
                                  _words(old, new))
         if labels is None:

@@ -12,13 +12,14 @@ from tests.helpers import figures, rendered
 
 
 def _drawn(fig) -> dict:
-    """What a figure shows in words and axes: its axis labels, hover tooltips and axis ranges,
-    and the columns of its glyphs' data sources (by legend label)."""
+    """What a figure shows in words and axes: its axis labels, hover tooltips and axis ranges
+    (and where its Reset tool returns them), and the columns of its glyphs' data sources (by legend label)."""
     sources = {r.name: {k: np.asarray(v) for k, v in r.data_source.data.items()}
                for r in fig.renderers if hasattr(r, "data_source") and r.name}
     return {"x": fig.xaxis[0].axis_label, "y": fig.yaxis[0].axis_label,
             "tips": [list(t.tooltips) for t in fig.toolbar.tools if isinstance(t, HoverTool)],
-            "ranges": (fig.x_range.start, fig.x_range.end, fig.y_range.start, fig.y_range.end),
+            "ranges": (fig.x_range.start, fig.x_range.end, fig.y_range.start, fig.y_range.end,
+                       fig.x_range.reset_start, fig.x_range.reset_end, fig.y_range.reset_start, fig.y_range.reset_end),
             "sources": sources}
 
 
