@@ -34,21 +34,30 @@ def _same(a: dict, b: dict) -> bool:
                for n in a["sources"])
 
 
+BANDS = {"tolerance_text": "mu:10,L:1", "band_on": True}
+
+
 def _fresh(state) -> dict:
-    """The explorer's figures drawn by HoloViews from scratch, in the mode and at the amplitude of
-    ``state`` (an ExplorerState: a switch converts the amplitude at equal strain, to 3 digits)."""
+    """The explorer's figures drawn by HoloViews from scratch, in the mode, at the amplitude and
+    with the bands of ``state`` (an ExplorerState: a switch converts the amplitude at equal
+    strain, to 3 digits)."""
     app = App()
+    app.state.param.update(tolerance_text=state.tolerance_text, band_on=state.band_on)
     app.state.mode = state.mode
     app.state.amplitude = state.amplitude
     return {t: _drawn(f) for t, f in figures(rendered(app.template())).items()}
 
 
-@pytest.mark.parametrize("mode", ["torsion", "conical", "radial"])
-def test_a_mode_switch_is_written_into_the_models_holoviews_made(mode):
-    """Axial → ``mode`` → axial: no plot is drawn again by HoloViews (no Pipe event: counted), the
+@pytest.mark.parametrize(("mode", "bands"), [("torsion", False), ("conical", False), ("radial", False),
+                                             ("torsion", True)])
+def test_a_mode_switch_is_written_into_the_models_holoviews_made(mode, bands):
+    """Axial → ``mode`` → axial (with tolerance bands if ``bands``: their tooltips name the band's
+    top in the new unit too): no plot is drawn again by HoloViews (no Pipe event: counted), the
     document keeps every model it had, and each figure shows the axis labels, tooltips (the new
     units), ranges and data HoloViews draws for that mode from scratch."""
     app = App()
+    if bands:
+        app.state.param.update(**BANDS)
     doc = rendered(app.template())
     asked = []
     for live in (app.plots.loop, app.plots.grid):
