@@ -4,15 +4,17 @@ A :class:`LivePlot` shows a list of HoloViews overlays, one plot each (a Dynamic
 stream). HoloViews builds each plot: its dimensions, styles, legend, linked axes and tap
 stream. :meth:`LivePlot.show` then takes the next frames:
 
-* a frame of the same shape as the one shown (the same elements, styles and dimensions; other
-  numbers) is written straight into the Bokeh models HoloViews made (:func:`app.patches.written`:
-  each changed element's columns, as HoloViews' own ``get_data`` makes them, a marker's position,
-  the axis ranges), and the Pipe keeps it without an event. HoloViews' per-update path, which
-  recomputes every subplot's ranges, styles, legend and axes, is not taken: measured on the
-  explorer, the server's CPU per amplitude change fell from 82 ms to 31 ms;
-* a frame of another shape (a pinned reference, measured points, bands switched on, new units)
-  goes down the Pipe: HoloViews updates the Bokeh models in place; an overlay that gains an
-  element gets a new glyph and legend entry, one that loses it hides them.
+* a frame of the same shape as the one shown (the same elements, styles and dimension names;
+  other numbers, and other dimension labels and units after a mode switch) is written straight
+  into the Bokeh models HoloViews made (:func:`app.patches.written`: each changed element's
+  columns, as HoloViews' own ``get_data`` makes them, a marker's position, the axis ranges, the
+  axis labels and the hover tooltips' words), and the Pipe keeps it without an event.
+  HoloViews' per-update path, which recomputes every subplot's ranges, styles, legend and axes,
+  is not taken: measured on the explorer, the server's CPU per amplitude change fell from 82 ms
+  to 31 ms, per mode switch from 95 ms to 30 ms (``benchmarks/mode_switch_cpu.py``);
+* a frame of another shape (a pinned reference, measured points, bands switched on) goes down
+  the Pipe: HoloViews updates the Bokeh models in place; an overlay that gains an element gets a
+  new glyph and legend entry, one that loses it hides them.
 
 The page is never laid out again. Three costs that were measured here and are avoided
 (explorer, Chromium, this machine):
@@ -42,6 +44,7 @@ import numpy as np
 import panel as pn
 
 from . import patches
+from .plotting.style import style_key
 
 log = logging.getLogger("bushing.app")
 
@@ -75,17 +78,20 @@ def _same_data(a: hv.Element, b: hv.Element) -> bool:
 
 
 def _shape(overlay) -> tuple | None:
-    """What HoloViews builds a plot from, numbers aside: each element's kind, key, style (its
-    options' id: the elements are clones of styled templates) and dimensions (names, labels,
-    units). Two frames of one shape differ in their numbers only (data, ranges, a marker)."""
+    """What HoloViews builds a plot from, numbers and words aside: each element's kind, key,
+    style (:func:`app.plotting.style.style_key`: the elements are clones of styled templates) and
+    dimension names. Two frames of one shape differ in their numbers (data, ranges, a marker) and
+    in the words of their dimensions only (labels and units, after a mode switch: the axis labels
+    and the tooltips' words)."""
     if not isinstance(overlay, hv.Overlay):
         return None
-    return tuple((type(el), key, el.id, tuple((d.name, d.label, d.unit) for d in el.dimensions()))
+    return tuple((type(el), key, style_key(el), tuple(d.name for d in el.dimensions()))
                  for key, el in overlay.data.items())
 
 
 def same_shape(old, new) -> bool:
-    """Whether overlays ``old`` and ``new`` differ in their numbers only (:func:`_shape`)."""
+    """Whether overlays ``old`` and ``new`` differ in their numbers and dimension words only
+    (:func:`_shape`)."""
     shape = _shape(old)
     return shape is not None and shape == _shape(new)
 

@@ -68,7 +68,8 @@ a change sets arrives in one message and is painted at once.
 (kinds, labels, styles, dimensions) differs only in its numbers, and those are written into the
 Bokeh models HoloViews made: each changed element's columns (HoloViews' own ``get_data`` makes
 them) into its glyph's data source, a marker's position into its span, the frame's axis ranges
-into the figure's ranges. HoloViews' per-update path (ranges, styles, legends and axes of every
+into the figure's ranges (and the Reset tool's), the words of its dimensions (labels and units,
+new after a mode switch) into the axis labels and the hover tooltips. HoloViews' per-update path (ranges, styles, legends and axes of every
 subplot recomputed) is skipped. Measured on the explorer with ``benchmarks/explorer_change.py``
 (30 changes, medians): server CPU per amplitude change 82 ms before this hook, 31 ms with it. Panel keeps a pane's HoloViews plots in the private
 ``HoloViews._plots`` (one per root model); the plot's ``subplots``, ``handles`` and
@@ -304,8 +305,9 @@ def install_bokehjs_patches(doc):
 
 def holoviews_plots(pane) -> list:
     """The HoloViews plots a Panel HoloViews pane has rendered (one per page showing it; none before
-    it is shown)."""
-    return [plot for plot, _model in getattr(pane, "_plots", {}).values()]
+    it is shown), each once (Panel files a plot under each root model it is rendered in: a page's
+    template and the pane's own root)."""
+    return list({id(plot): plot for plot, _model in getattr(pane, "_plots", {}).values()}.values())
 
 
 def _axis_range(dim) -> tuple[float, float] | None:
@@ -327,6 +329,44 @@ def _element_data(subplot, element) -> dict | None:
     if source is None or set(data) != set(source.data):
         return None
     return data
+
+
+def _words(old, new) -> dict | None:
+    """Each dimension label (with its unit, as HoloViews prints it) of overlay ``old`` → that of
+    the dimension of the same name at the same place in ``new``; None if one label would become
+    two."""
+    out = {}
+    for a, b in zip(old.values(), new.values()):
+        for da, db in zip(a.dimensions(), b.dimensions()):
+            if da.name != db.name or out.setdefault(da.pprint_label, db.pprint_label) != db.pprint_label:
+                return None
+    return out
+
+
+def _labels_written(plot, was: tuple, now: tuple, words: dict | None) -> list | None:
+    """The writes that put the words of dimensions ``now`` (x, y) where HoloViews drew those of
+    ``was``: the axis labels and the hover tooltips' labels (:data:`app.plotting.style.CURVE_TIP`
+    and one ``(label, "@{name}")`` per dimension). None if the plot's axes or tooltips do not
+    show ``was`` as expected (then HoloViews must draw the new words itself)."""
+    if words is None:
+        return None
+    writes = []
+    for handle, before, after in zip(("xaxis", "yaxis"), was, now):
+        axis = plot.handles.get(handle)
+        if axis is None or getattr(axis, "axis_label", None) != before.pprint_label:
+            return None
+        if after.pprint_label != before.pprint_label:
+            writes.append((axis, {"axis_label": after.pprint_label}))
+    for tool in plot.state.toolbar.tools:
+        if tool.__class__.__name__ != "HoverTool":
+            continue
+        tips = tool.tooltips
+        if not isinstance(tips, list) or not all(isinstance(t, tuple) and len(t) == 2 for t in tips):
+            return None
+        renamed = [(words.get(label, label), field) for label, field in tips]
+        if renamed != list(tips):
+            writes.append((tool, {"tooltips": renamed}))
+    return writes
 
 
 def written(plot, old, new):
@@ -352,14 +392,21 @@ def written(plot, old, new):
         if data is None:
             return None
         writes.append((sub.handles["source"], {"data": data}))
-    first = next((el for el in new.values() if el.__class__.__name__ not in ("VLine", "HLine")), None)
-    if first is not None:
+    index = next((i for i, el in enumerate(new.values()) if el.__class__.__name__ not in ("VLine", "HLine")), None)
+    if index is not None:
+        first, was = new.values()[index], old.values()[index]
         for axis, dim in (("x_range", first.kdims[0]), ("y_range", first.vdims[0])):
             rng, model = _axis_range(dim), plot.handles.get(axis)
             if rng is None or model is None or not hasattr(model, "start"):
                 return None
-            if (model.start, model.end) != rng:
-                writes.append((model, {"start": rng[0], "end": rng[1]}))
+            if (model.start, model.end) != rng or (getattr(model, "reset_start", None), getattr(model, "reset_end", None)) != rng:
+                # and where the Reset tool returns to, as HoloViews sets it (else the first frame's range)
+                writes.append((model, {"start": rng[0], "end": rng[1], "reset_start": rng[0], "reset_end": rng[1]}))
+        labels = _labels_written(plot, (was.kdims[0], was.vdims[0]), (first.kdims[0], first.vdims[0]),
+                                 _words(old, new))
+        if labels is None:
+            return None
+        writes += labels
 
     def write():
         for model, values in writes:

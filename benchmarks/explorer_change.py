@@ -238,7 +238,7 @@ class Session:
                 return any(not a[1] for a in self.arrivals)
         self.arrivals = []
         c0, t0 = cpu_ns(self.pid), time.perf_counter()
-        model.value = value
+        model.value = str(value) if isinstance(model.value, str) else value  # a typed field (TextInput) holds text
         self.loop.run_sync(lambda: self._settle(answered, t0))
         c1 = cpu_ns(self.pid)
         self._apply_received()
@@ -254,7 +254,7 @@ def positions(model, n: int) -> list[float]:
     """``n`` values cycling over four inside the widget's range, none equal to the last."""
     start = getattr(model, "start", None) if "start" in model.properties() else getattr(model, "low", None)
     end = getattr(model, "end", None) if "end" in model.properties() else getattr(model, "high", None)
-    v = model.value
+    v = float(model.value)
     if start is None or end is None:  # an open field: around its value
         cycle = [v * f for f in (0.8, 0.9, 1.1, 1.2)]
     else:
@@ -339,7 +339,7 @@ TEXT_JS = """async ([title, value]) => {
   const text = [...doc.all_models].find(m => (m.css_classes || []).includes('operating-point'));
   const before = text.text;
   const t0 = performance.now();
-  model.value = value;
+  model.value = typeof model.value === 'string' ? String(value) : value;  // a typed field (TextInput) holds text
   const t = await new Promise(resolve => {
     const tick = () => {
       if (text.text !== before) requestAnimationFrame(() => resolve(performance.now()));

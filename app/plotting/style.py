@@ -199,7 +199,27 @@ def template(kind: str, key: tuple) -> hv.Element | hv.Overlay:
     element = {"Curve": hv.Curve, "Scatter": hv.Scatter, "Area": hv.Area, "VLine": hv.VLine,
                "HLine": hv.HLine, "Bars": hv.Bars, "Points": hv.Points, "Overlay": hv.Overlay}[kind]
     empty = 0.0 if kind in ("VLine", "HLine") else []
-    return element(empty).opts(**{k: _thaw(v) for k, v in key})
+    made = element(empty).opts(**{k: _thaw(v) for k, v in key})
+    _STYLES[made.id] = (kind, tuple((k, _unlabelled(v) if k == "hover_tooltips" else v) for k, v in key))
+    return made
+
+
+# a template's options id → its kind and options, the hover tooltips' labels left out (see style_key)
+_STYLES: dict[int, tuple] = {}
+
+
+def _unlabelled(tooltips):
+    """A frozen tooltip list (:func:`_freeze`) without its labels: the fields it reads."""
+    items = tooltips[1] if isinstance(tooltips, tuple) and tooltips[:1] == ("<list>",) else tooltips
+    return tuple(tip[1] if isinstance(tip, tuple) and len(tip) == 2 else tip for tip in items)
+
+
+def style_key(element) -> tuple | int | None:
+    """What ``element`` is drawn with, but for the words of its hover tooltips (the labels of its
+    dimensions, with their units: they change with the mode, the fields they read do not): two
+    elements with one style key are drawn alike, their tooltips' labels aside. An element not
+    made by :func:`styled`: its options' id."""
+    return _STYLES.get(element.id, element.id)
 
 
 def _freeze(value):
