@@ -129,7 +129,8 @@ def _judge(design: Design, filename: str, frequency_hz, amplitude, magnitude, co
     ratio = _median_ratio(design, frequency_hz, amplitude, magnitude)
     far = max(ratio, 1 / ratio)
     if top > MAX_PLAUSIBLE_STRAIN or bottom < MIN_MEASURED_STRAIN:
-        where = f"{filename}: column {amplitude_column}"
+        where = f"{filename}: " + (f"column {amplitude_column}" if amplitude_column == "amplitude" else
+                                   f"the amplitude of column {amplitude_column}")
         try:  # the data rule (resolution to breaking strain), in its own words
             check_measured_amplitude(design, amplitude, where)
             said = (f"{where}: {_span(amplitude, a_unit)} would strain this {design.mode} bushing up to "
