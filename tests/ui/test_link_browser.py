@@ -32,7 +32,7 @@ def test_a_diagnosed_designs_link_reproduces_its_numbers_and_effects(page, conte
     mystery_demo(page, explorer_url)
     page.get_by_role("button", name="Use the final model in the explorer").click()
     status = page.locator(".design-status").locator("div").first  # the design's name, mode, effects
-    expect(status).to_contain_text(re.compile(r"\(diagnosed\), \w+; effects: \w+"))  # what the demo hid
+    expect(status).to_contain_text(re.compile(r"\(fitted\), \w+; effects: \w+"))  # what the demo hid
     said = status.inner_text()
     page.get_by_text("Explorer", exact=True).click()
     page.wait_for_url(re.compile(r"effects="))
