@@ -294,24 +294,17 @@ def shown_measure(target, value: float) -> str:
 
 
 def target_words(target) -> str:
-    """A target in the display units of the form (``axial |K| = 4.5 kN/mm ± 1 % at 10 Hz, 0.1 mm``)."""
+    """A target in the display units of the form (``axial |K| = 4.5 kN/mm ± 1 % at 10 Hz, 0.1 mm``):
+    :meth:`core.whatif.target.Target.describe` with the form's units and the one formatter."""
     t = target
-    amp = " and ".join(format_value(units.display_amplitude(x, m), units.amplitude_unit(m), "amplitude")
-                       for m, x in zip(t.modes, t.amplitudes))
-    what = (f"|K_{t.modes[0]}|/|K_{t.modes[1]}|" if t.is_ratio else
-            f"{t.modes[0]} {'|K|' if t.quantity == 'magnitude' else 'loss factor'}")
-    if t.is_ratio or t.quantity == "loss_factor":
-        def shown(v):
+
+    def shown(v):
+        if t.is_ratio or t.quantity == "loss_factor":
             return format_value(v, "", "ratio" if t.is_ratio else "loss_factor")
-    else:
-        def shown(v):
-            return format_value(units.display_stiffness(v, t.modes[0]), MODE[t.modes[0]].stiffness.display, "stiffness")
-    if t.value is not None:
-        goal = f"= {shown(t.value)}"
-    else:
-        goal = " and ".join(p for p in ((f"≥ {shown(t.low)}" if t.low is not None else ""),
-                                        (f"≤ {shown(t.high)}" if t.high is not None else "")) if p)
-    return f"{what} {goal} at {format_value(t.frequency_hz, 'Hz', 'frequency')}, {amp}"
+        return format_value(units.display_stiffness(v, t.modes[0]), MODE[t.modes[0]].stiffness.display, "stiffness")
+
+    return t.describe(shown, lambda x, m: format_value(units.display_amplitude(x, m), units.amplitude_unit(m), "amplitude"),
+                      lambda f: format_value(f, "Hz", "frequency"))
 
 
 def limit_words(item: str) -> str:

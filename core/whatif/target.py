@@ -81,17 +81,26 @@ class Target:
             return abs(k[0]) / abs(k[1])
         return abs(k[0]) if self.quantity == "magnitude" else float(loss_factor(k[0]))
 
-    def describe(self) -> str:
-        amp = " and ".join(f"{x:.4g} {MODE[m].amplitude.si}" for m, x in zip(self.modes, self.amplitudes))
+    def describe(self, value=None, amplitude=None, frequency=None) -> str:
+        """The target in words (``axial |K| = 4.5e+06 N/m at 10 Hz, 0.0001 m``). ``value``,
+        ``amplitude`` and ``frequency`` write its numbers (functions of the SI value, and of the mode
+        for an amplitude, to text with its unit); by default SI to 4 significant digits."""
+        def si(v):
+            unit = "" if self.is_ratio or self.quantity == "loss_factor" else f" {MODE[self.modes[0]].stiffness.si}"
+            return f"{v:.4g}{unit}"
+
+        value = value or si
+        amplitude = amplitude or (lambda x, m: f"{x:.4g} {MODE[m].amplitude.si}")
+        frequency = frequency or (lambda f: f"{f:.4g} Hz")
+        amp = " and ".join(amplitude(x, m) for m, x in zip(self.modes, self.amplitudes))
         what = (f"|K_{self.modes[0]}|/|K_{self.modes[1]}|" if self.is_ratio else
                 f"{self.modes[0]} {'|K|' if self.quantity == 'magnitude' else 'loss factor'}")
-        unit = "" if self.is_ratio or self.quantity == "loss_factor" else f" {MODE[self.modes[0]].stiffness.si}"
         if self.value is not None:
-            goal = f"= {self.value:.4g}{unit}"
+            goal = f"= {value(self.value)}"
         else:
-            goal = " and ".join(p for p in ((f"≥ {self.low:.4g}{unit}" if self.low is not None else ""),
-                                            (f"≤ {self.high:.4g}{unit}" if self.high is not None else "")) if p)
-        return f"{what} {goal} at {self.frequency_hz:.4g} Hz, {amp}"
+            goal = " and ".join(p for p in ((f"≥ {value(self.low)}" if self.low is not None else ""),
+                                            (f"≤ {value(self.high)}" if self.high is not None else "")) if p)
+        return f"{what} {goal} at {frequency(self.frequency_hz)}, {amp}"
 
     def misses(self, value: float) -> float:
         """How far ``value`` lies outside the target, relative (0 inside, or within
