@@ -148,7 +148,7 @@ class DesignInputs(pn.viewable.Viewer):
         }
         self.widgets = self.fields  # kept name: a field's ``value`` is the state's
         self.preset = pn.widgets.Select(
-            name=state.param.preset.label, options=[*PRESETS, CUSTOM], value=shown_preset(state.design),
+            label=state.param.preset.label, options=[*PRESETS, CUSTOM], value=shown_preset(state.design),
             description=state.param.preset.doc + f" “{CUSTOM}”: the design is none of them.",
             sizing_mode="stretch_width",
         )
