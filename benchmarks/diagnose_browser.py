@@ -81,7 +81,7 @@ def measure(page, url: str, csv: Path) -> dict:
                            timeout=120_000)
     page.get_by_text("Find the missing effect", exact=True).click()
     page.get_by_role("button", name="Diagnose").wait_for(timeout=60_000)
-    page.locator("input[type=file]").last.set_input_files(str(csv))
+    page.locator("#main input[type=file]").last.set_input_files(str(csv))
     page.get_by_text("150 points").first.wait_for(timeout=60_000)
     page.evaluate(WATCH_JS)
     page.get_by_role("button", name="Diagnose").click()

@@ -65,7 +65,7 @@ def measure(browser, url: str, pid: int, path: Path, n: int) -> dict:
         idle(page)
         summary = page.get_by_text("Stiffness:", exact=False).filter(has_text="points")
         cpu0, t0 = cpu_seconds(pid), time.perf_counter()
-        page.locator("input[type=file]").first.set_input_files(str(path))
+        page.locator("#main input[type=file]").first.set_input_files(str(path))
         summary.first.wait_for(timeout=60_000)
         t1 = time.perf_counter()
         idle(page)
