@@ -11,6 +11,7 @@ import math
 import param
 
 from core import Design
+from core.numbers import format_number
 from core.parameters import BY_NAME, DEFAULT_SHAPE, GEOMETRY, MATERIAL, PARAMETERS
 from core.rules import OUTER_NOT_LARGER, RuleError, decimal
 from core.shape import OutsideTable, table
@@ -154,7 +155,7 @@ def tolerances_of(key: tuple) -> Tolerances:
 def _shown(name: str, value: float) -> str:
     """``value`` (SI) of parameter ``name`` in its display unit: ``17.5 mm``."""
     unit = BY_NAME[name].unit
-    return f"{unit.to_display(value):.4g} {unit.display}".rstrip()
+    return f"{format_number(unit.to_display(value), 4)} {unit.display}".rstrip()
 
 
 def tolerance_refusal(tolerance_pct: dict[str, float], design: Design) -> tuple[tuple[str, ...], str]:
@@ -187,7 +188,7 @@ def _refusal_words(exc: ToleranceError, relative: dict[str, float], design: Desi
             (name,) = named
             other = "outer_radius" if name == "inner_radius" else "inner_radius"
             bound = (f"with {BY_NAME[other].symbol} = {_shown(other, design.value(other))}, the tolerance of "
-                     f"{BY_NAME[name].symbol} must stay below {100 * (b - a) / design.value(name):.3g} %")
+                     f"{BY_NAME[name].symbol} must stay below {format_number(100 * (b - a) / design.value(name), 3)} %")
         else:
             bound = f"the two half-widths together must stay below b − a = {_shown('length', b - a)}"
         lets = "lets" if len(named) == 1 else "let"
@@ -225,7 +226,7 @@ def _outside_table(relative: dict[str, float], design: Design) -> tuple[tuple[st
     given = ", ".join(f"{BY_NAME[n].symbol} ± {100 * relative[n]:g} %" for n in named)
     way_out = (" (or switch off the finite-length shape factor: the long-bushing formula)"
                if DEFAULT_SHAPE[design.mode] != "finite" else "")
-    return named, (f"With {given}, b/a spans {min(radius):.3g}–{max(radius):.3g} and L/(b − a) "
-                   f"{min(length):.3g}–{max(length):.3g}; the finite-length table covers b/a "
+    return named, (f"With {given}, b/a spans {format_number(min(radius), 3)}–{format_number(max(radius), 3)} and L/(b − a) "
+                   f"{format_number(min(length), 3)}–{format_number(max(length), 3)}; the finite-length table covers b/a "
                    f"{t.radius_ratio[0]:g}–{t.radius_ratio[-1]:g} and L/(b − a) {t.length_ratio[0]:g}–"
                    f"{t.length_ratio[-1]:g}: narrow the tolerance{way_out}.")

@@ -14,7 +14,7 @@ import param
 
 from core import PAPER_B, Design, DesignError, Geometry, Material
 from core.bushing import factors
-from core.numbers import range_problem, rounded
+from core.numbers import format_number, range_problem, rounded
 from core.parameters import BY_NAME, DEFAULT_SHAPE, GEOMETRY, MATERIAL, PARAMETERS, DesignParameter
 from core.parts import MAX_MODULUS, SIZE_RANGE, STRAIN_HALF_RANGE, as_dict
 from core.rules import NOT_POSITIVE, ORDER_RANGE, OUT_OF_RANGE, OUTER_NOT_LARGER
@@ -103,19 +103,19 @@ def outside_table(geometry: Geometry, mode: str) -> tuple[str, tuple[str, ...]]:
 
     def span(name: str, low: float, high: float) -> str:
         unit = mm[name]
-        return f"{unit.to_display(low):.3g}–{unit.to_display(high):.3g} {unit.display}"
+        return f"{format_number(unit.to_display(low), 3)}–{format_number(unit.to_display(high), 3)} {unit.display}"
 
     def value(name: str, v: float) -> str:
-        return f"{BY_NAME[name].symbol} = {mm[name].to_display(v):.3g} {mm[name].display}"
+        return f"{BY_NAME[name].symbol} = {format_number(mm[name].to_display(v), 3)} {mm[name].display}"
 
     parts, involved = [], []
     if not lo_r <= b / a <= hi_r:
-        parts.append(f"b/a is {b / a:.3g}, the table covers {lo_r:g}–{hi_r:g}: with {value('inner_radius', a)}, "
+        parts.append(f"b/a is {format_number(b / a, 3)}, the table covers {lo_r:g}–{hi_r:g}: with {value('inner_radius', a)}, "
                      f"b may be {span('outer_radius', lo_r * a, hi_r * a)}")
         involved += [_INNER, _OUTER]
     if not lo_l <= L / (b - a) <= hi_l:
-        parts.append(f"L/(b − a) is {L / (b - a):.3g}, the table covers {lo_l:g}–{hi_l:g}: with b − a = "
-                     f"{mm['length'].to_display(b - a):.3g} {mm['length'].display}, L may be "
+        parts.append(f"L/(b − a) is {format_number(L / (b - a), 3)}, the table covers {lo_l:g}–{hi_l:g}: with b − a = "
+                     f"{format_number(mm['length'].to_display(b - a), 3)} {mm['length'].display}, L may be "
                      f"{span('length', lo_l * (b - a), hi_l * (b - a))}")
         involved += [_INNER, _OUTER, _LENGTH]
     way_out = (" Or switch off the finite-length shape factor (the long-bushing formula)."

@@ -21,7 +21,7 @@ from panel.util import parse_query
 
 from core import PAPER_B, Design, DesignError
 from core.effects import validate_effects
-from core.numbers import link_number
+from core.numbers import format_number, link_number
 from core.parameters import PARAMETERS
 from core.rules import RuleError, decimal
 
@@ -230,7 +230,7 @@ def apply_link(state: ExplorerState, search: str):
         else:
             unit = amplitude_unit(state.design.mode)
             refused["amplitude"] = said("amp", amplitude, f"is outside this bushing's amplitude axis "
-                                        f"({low:.3g}–{high:.3g} {unit})", f"{state.amplitude:g} {unit}")
+                                        f"({format_number(low, 3)}–{format_number(high, 3)} {unit})", f"{state.amplitude:g} {unit}")
     if raw.get("name") and not state.errors and raw["name"][:NAME_LENGTH] != state.design.name:
         state.name_design(raw["name"][:NAME_LENGTH])
     reference = {k.removeprefix(REFERENCE): v for k, v in raw.items() if k.startswith(REFERENCE)}

@@ -20,7 +20,7 @@ import param
 from core import PAPER_B, TABLE_1, Design
 from core.data import DataError, MeasuredLoop, MeasuredStiffness
 from core.io.measured import combined, parse_loop, parse_stiffness
-from core.numbers import rounded
+from core.numbers import format_number, rounded
 from core.parameters import MODE_TABLE, MODES
 from core.plausibility import loop_verdict, stiffness_column, stiffness_verdict
 
@@ -167,7 +167,7 @@ class ExplorerState(DesignFields, ToleranceBands):
         self.param.update(
             **_shown_values(design),
             effects=design.portable_effects,  # a rig's mass stays with its mode
-            amplitude=float(f"{x_mid:.3g}"),
+            amplitude=rounded(x_mid, 3),
         )
 
     # ---- measured data (their fit: app.fit_state.FitState) ------------------------------------
@@ -199,10 +199,10 @@ class ExplorerState(DesignFields, ToleranceBands):
         unit = units.amplitude_unit(self.design.mode)
         problem = None
         if not FREQUENCY_BOUNDS[0] <= f <= FREQUENCY_BOUNDS[1]:
-            problem = f"its frequency {f:.3g} Hz is outside {FREQUENCY_BOUNDS[0]:g}–{FREQUENCY_BOUNDS[1]:g} Hz"
+            problem = f"its frequency {format_number(f, 3)} Hz is outside {FREQUENCY_BOUNDS[0]:g}–{FREQUENCY_BOUNDS[1]:g} Hz"
         elif not lo <= x <= hi:
-            problem = (f"its amplitude {x:.3g} {unit} is outside this bushing's amplitude axis "
-                       f"({lo:.3g}–{hi:.3g} {unit})")
+            problem = (f"its amplitude {format_number(x, 3)} {unit} is outside this bushing's amplitude axis "
+                       f"({format_number(lo, 3)}–{format_number(hi, 3)} {unit})")
         if problem:
             self.data_message = f"{filename}: {problem}; not loaded"
             return False
@@ -210,8 +210,8 @@ class ExplorerState(DesignFields, ToleranceBands):
         frequency, amplitude = rounded(float(np.clip(f, *FREQUENCY_BOUNDS)), 4), rounded(x, 4)
         moved = ""
         if (frequency, amplitude) != (self.frequency_hz, self.amplitude):
-            moved = (f"{filename}: the operating point moved to the loop's {frequency:.4g} Hz and {amplitude:.4g} "
-                     f"{unit} (it was {self.frequency_hz:.4g} Hz, {self.amplitude:.4g} {unit}), so that the "
+            moved = (f"{filename}: the operating point moved to the loop's {format_number(frequency, 4)} Hz and {format_number(amplitude, 4)} "
+                     f"{unit} (it was {format_number(self.frequency_hz, 4)} Hz, {format_number(self.amplitude, 4)} {unit}), so that the "
                      "model's loop is drawn over the measured one.")
         self.param.update(measured_loop=data, frequency_hz=frequency, amplitude=amplitude, data_message="",
                           data_note=" ".join(n for n in (verdict.warning, moved) if n))
@@ -304,7 +304,7 @@ def same_strain(amplitude: float, old: str, new: str, design: Design, shape: str
         x = units.display_amplitude(Design(new, g, m, shape=shape).drive(eps), new)
     except ValueError:
         return None
-    return float(f"{x:.3g}")
+    return rounded(x, 3)
 
 
 def measured_amplitudes(measured: MeasuredStiffness | None) -> list[float]:
