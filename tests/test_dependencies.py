@@ -28,3 +28,49 @@ def test_every_direction_and_the_app_run_without_the_fe_library():
     )
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+COPYLEFT = ("GPL", "AGPL", "GNU General Public", "Affero")  # LGPL and MPL-2.0 are fine to depend on
+
+
+def licence_of(dist) -> str:
+    meta = dist.metadata
+    classifiers = [c for c in meta.get_all("Classifier") or [] if c.startswith("License ::")]
+    return " | ".join(filter(None, [meta.get("License-Expression"), (meta.get("License") or "")[:200], *classifiers]))
+
+
+def runtime_closure() -> dict[str, str]:
+    """Every distribution the installed package needs at run time (its requirements without
+    extras, and theirs), with its declared licence."""
+    from importlib import metadata
+
+    from packaging.requirements import Requirement
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    todo, seen = [Requirement(r).name for r in project["dependencies"]], {}
+    while todo:
+        name = todo.pop().lower().replace("_", "-")
+        if name in seen:
+            continue
+        dist = metadata.distribution(name)
+        seen[name] = licence_of(dist)
+        todo += [Requirement(r).name for r in dist.requires or []
+                 if Requirement(r).marker is None or Requirement(r).marker.evaluate({"extra": ""})]
+    return seen
+
+
+def test_the_project_has_a_permissive_licence_and_so_has_everything_it_runs_on():
+    """BSD-3-Clause (the licence of Panel, HoloViews and Bokeh), declared in pyproject.toml and
+    written in LICENSE; no run-time dependency, direct or indirect, is under the GPL (felupe,
+    GPL-3.0, stays an extra)."""
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    assert project["license"] == "BSD-3-Clause"
+    text = (ROOT / "LICENSE").read_text(encoding="utf-8")
+    assert text.startswith("BSD 3-Clause License") and "Neither the name of the copyright holder" in text
+    closure = runtime_closure()
+    assert {"numpy", "scipy", "panel", "holoviews", "bokeh"} <= closure.keys()
+    assert "felupe" not in closure
+    for name, licence in closure.items():
+        assert licence.strip(), f"{name} declares no licence"
+        words = licence.replace("LGPL", "").replace("Lesser General Public", "")
+        assert not any(c in words for c in COPYLEFT), f"{name}: {licence}"

@@ -32,6 +32,7 @@ OTHER_PARTS = {
     "Dockerfile": "the explorer as a container",
     "pyproject.toml": "the package, its dependencies and the `bushing` command",
     ".ci/run": "CI: the README's test command",
+    "LICENSE": "BSD-3-Clause",
 }
 ROLE = re.compile(r":(?:mod|func|class|data|meth):`~?\.?([^`]+)`")
 
