@@ -369,8 +369,8 @@ def run_sessions(ws_url: str, n: int, plan: Plan, time_limit: float, routes: boo
     if on_phase:
         on_phase("opened")
     run.changes_go.set()
-    for s in sessions:
-        s.join(max(0.0, run.deadline - time.monotonic()) + 5)
+    for s in sessions:  # each has stopped by the deadline; 5 s more to close
+        s.join(max(0.0, run.deadline + 5 - time.monotonic()))
     if on_phase:
         on_phase("end")
     return [s.out for s in sessions]
