@@ -46,8 +46,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from load_session import (
     Plan,
     cpu_seconds,
-    liveness,
     port_of,
+    probe,
     rss_mb,
     run_sessions,
     start_explorer,
@@ -68,14 +68,14 @@ class Poller(threading.Thread):
 
     def __init__(self, url: str):
         super().__init__(daemon=True)
-        self.url, self.times, self.failures = url, [], 0
+        self.url, self.times, self.failures = url, [], Counter()
         self.done = threading.Event()
 
     def run(self):
         while not self.done.wait(1.0):
-            t = liveness(self.url)
+            t, why = probe(self.url)
             if t is None:
-                self.failures += 1
+                self.failures[why] += 1
             else:
                 self.times.append(t)
 
@@ -116,6 +116,9 @@ def report(r: dict):
         print(f"  opens        0/{r['n']}")
     for reason, count in r["errors"].most_common():
         print(f"  open errors  {count} × {reason}")
+    waiting = r["n"] - len(o) - sum(r["errors"].values())
+    if waiting:
+        print(f"  still opening at the time limit (no answer, no refusal): {waiting}")
     a = r["answered"]
     if a:
         print(f"  changes      {len(a)} answered   p50 {statistics.median(a):6.0f} ms   p95 {pct(a, 95):6.0f} ms   "
@@ -127,7 +130,8 @@ def report(r: dict):
     grown = (sum(r["rss_open"]) - sum(r["rss"])) / max(1, len(o))
     print(f"  RSS MB       idle → opened → end, per process: {rss}   (+{grown:.1f} MB per session opened)")
     live = r["live"]
-    print(f"  /liveness    {len(live)} answered (max {max(live, default=0):.2f} s), {r['live_failed']} failed")
+    failed = ", ".join(f"{n} × {why}" for why, n in r["live_failed"].most_common()) or "none failed"
+    print(f"  /liveness    {len(live)} answered (max {max(live, default=0):.2f} s); {failed}")
 
 
 def ratios(a: dict, b: dict):

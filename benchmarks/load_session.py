@@ -30,6 +30,7 @@ import subprocess
 import sys
 import threading
 import time
+import urllib.error
 import urllib.request
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -132,12 +133,27 @@ def rss_mb(pid: int) -> float:
 
 def liveness(url: str, timeout: float = 5.0) -> float | None:
     """Seconds ``url``'s ``/liveness`` took to answer 200, or None (refused, error or timeout)."""
+    return probe(url, timeout)[0]
+
+
+def probe(url: str, timeout: float = 5.0) -> tuple[float | None, str | None]:
+    """``url``'s ``/liveness``: (seconds to a 200, None) or (None, why not: the status, "timeout",
+    "refused" or the error's name)."""
     t0 = time.perf_counter()
     try:
         with urllib.request.urlopen(url.rstrip("/") + "/liveness", timeout=timeout) as r:
-            return time.perf_counter() - t0 if r.status == 200 else None
-    except OSError:
-        return None
+            return (time.perf_counter() - t0, None) if r.status == 200 else (None, f"HTTP {r.status}")
+    except urllib.error.HTTPError as exc:
+        return None, f"HTTP {exc.code}"
+    except TimeoutError:
+        return None, f"no answer within {timeout:g} s"
+    except urllib.error.URLError as exc:
+        reason = exc.reason
+        if isinstance(reason, (TimeoutError, socket.timeout)):
+            return None, f"no answer within {timeout:g} s"
+        return None, "refused" if isinstance(reason, ConnectionRefusedError) else type(reason).__name__
+    except OSError as exc:
+        return None, type(exc).__name__
 
 
 # --- one session -----------------------------------------------------------------------------
