@@ -184,7 +184,7 @@ def main(argv=None):
     ap.add_argument("--nginx", action="store_true", help="nginx in front of one process too")
     ap.add_argument("--floors", action=argparse.BooleanOptionalAction, default=True)
     ap.add_argument("--time-limit", type=float, default=300.0, help="s per configuration (it stops by itself)")
-    ap.add_argument("--open-timeout", type=float, default=20.0, help="s, as bokeh.client's default")
+    ap.add_argument("--open-timeout", type=float, default=20.0, help="s for the websocket handshake (bokeh.client: 20)")
     ap.add_argument("--answer-timeout", type=float, default=30.0)
     a = ap.parse_args(argv)
     if not 1 <= a.sessions <= 200 or not 0 <= a.changes <= 100 or not all(1 <= k <= 8 for k in a.processes):
