@@ -16,8 +16,10 @@ the continuum (:mod:`core.slices`) and the stiffness-level effects (:mod:`core.e
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from dataclasses import dataclass
+from types import SimpleNamespace
 from typing import Literal
 
 import numpy as np
@@ -26,6 +28,7 @@ from . import material as mat
 from .design import Design
 from .effects import EFFECTS, branch_moduli, extended_modulus, inertia_correction, wave_stiffness
 from .parameters import MODE, THESIS_MODES
+from .parts import Material
 from .response import ComplexStiffness, loss_factor
 from .shape import shape_factor, strain_factor  # noqa: F401 (re-exported)
 from .slices import continuum_node_count, continuum_nodes, slice_nodes, solve_series
@@ -318,6 +321,55 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
     if not np.all(np.isfinite(k)):
         raise ValueError("the stiffness is not finite at these points (check the design's effects)")
     return np.array(k)
+
+
+def stiffness_points_many(designs, frequency_hz, amplitude) -> np.ndarray | None:
+    """:func:`stiffness_points` of several designs at once, shape (designs, *points), where they
+    differ only in their material's and effects' values (one mode, geometry, shape and set of
+    effects) and the route is the single equivalent modulus (eqs 14–18, with the material-level
+    effects, inertia and standing waves): the same formulas over arrays of parameters, one value
+    per design, so the same numbers. ``None`` where that is not so (the caller then evaluates
+    design by design): slices, the continuum (``nonuniform_strain``), designs that differ
+    otherwise. What a fit's finite-difference Jacobian needs: its columns change one parameter
+    each. Raises ValueError as :func:`stiffness_points` would for the first design it refuses."""
+    first = designs[0]
+    keys = [(d.mode, d.geometry, d.shape, tuple(eid for eid, _ in d.effects)) for d in designs]
+    effects = first.effect_parameters
+    if any(k != keys[0] for k in keys) or "nonuniform_strain" in effects:
+        return None
+    f, x = np.asarray(frequency_hz, float), np.asarray(amplitude, float)
+    shape = np.broadcast_shapes(f.shape, x.shape)
+    check_strain(first, x)
+    _check_series(first, 1)
+    n, ones = len(designs), (1,) * len(shape)
+
+    def column(values) -> np.ndarray:
+        return np.array(values, dtype=float).reshape((n, *ones))
+
+    material = SimpleNamespace(**{name: column([getattr(d.material, name) for d in designs])
+                                  for name in _MATERIAL_FIELDS})
+    every = [d.effect_parameters for d in designs]
+    params = {eid: {p: column([e[eid][p] for e in every]) for p in effects[eid]} for eid in effects}
+    if any(EFFECTS[e].term is not None for e in effects):
+        modulus = functools.partial(extended_modulus, material, params)
+    else:
+        modulus = functools.partial(mat.equivalent_modulus, material)
+    s, c = factors(first)
+    if "wave_effects" in effects:
+        geo = first.geometry
+        k = wave_stiffness(first.mode, geo.inner_radius, geo.outer_radius, geo.length,
+                           modulus(f, first.strain(x)), f, params["wave_effects"]["density"])
+    else:
+        k = equivalent_stiffness(modulus, s, c, f, x)
+    if "inertia" in effects:
+        k = inertia_correction(k, f, params["inertia"]["mass"])
+    k = np.broadcast_to(k, (n, *shape))
+    if not np.all(np.isfinite(k)):
+        raise ValueError("the stiffness is not finite at these points (check the design's effects)")
+    return np.array(k)
+
+
+_MATERIAL_FIELDS = tuple(f.name for f in dataclasses.fields(Material))
 
 
 @functools.lru_cache(maxsize=128)

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..bushing import check_measured_amplitude, stiffness_points
+from ..bushing import check_measured_amplitude, stiffness_points, stiffness_points_many
 from ..data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from ..design import Design
 from ..loops import loop_force
@@ -207,8 +207,27 @@ class _Problem:
         if self.loop is not None:
             f = sum(loop_force(design, self.loop_f, self.loop_amp, self.loop_phase))
             parts.append(self.loop_weight * (f - self.loop_force) / self.loop_scale)
-        r = np.concatenate(parts)
-        return np.where(np.abs(r) <= MAX_RESIDUAL, r, np.inf)  # NaN too: not evaluable there
+        return _evaluable(np.concatenate(parts))
+
+    def residuals_many(self, thetas: list[np.ndarray]) -> list[np.ndarray]:
+        """:meth:`residuals` at each of ``thetas``, the same numbers: the model of every point in
+        one evaluation (:func:`core.bushing.stiffness_points_many`) where it allows (stiffness
+        data of one mode, no loop), else point by point. What a finite-difference Jacobian asks."""
+        if self.data is None or self.loop is not None or self.data.mode is not None or len(thetas) < 2:
+            return [self.residuals(t) for t in thetas]
+        k = stiffness_points_many([self.model(t) for t in thetas], self.data.frequency_hz, self.data.amplitude)
+        if k is None:
+            return [self.residuals(t) for t in thetas]
+        out = []
+        for row in k:
+            r = relative_residual(row, self.data.stiffness) * self.data.weight
+            out.append(_evaluable(np.concatenate([r.real, r.imag])))
+        return out
+
+
+def _evaluable(r: np.ndarray) -> np.ndarray:
+    """Residuals beyond :data:`MAX_RESIDUAL` (NaN too) infinite: the model is not evaluable there."""
+    return np.where(np.abs(r) <= MAX_RESIDUAL, r, np.inf)
 
 
 def _uncertainties(problem: _Problem, sol) -> tuple[dict, dict, np.ndarray]:
@@ -248,7 +267,7 @@ def _solve(problem: _Problem, starts: list[np.ndarray]):
     for theta0 in starts:
         theta0 = np.clip(theta0, lo, hi)
         try:
-            sol, _ = minimise(problem.residuals, theta0, lo, hi, FIT_NFEV, xtol=1e-12)
+            sol, _ = minimise(problem.residuals, theta0, lo, hi, FIT_NFEV, xtol=1e-12, many=problem.residuals_many)
         except (ValueError, FloatingPointError, OverflowError):
             continue  # a start the model cannot evaluate: try the next
         if np.all(np.isfinite(sol.fun)) and (best is None or sol.cost < best.cost):
@@ -274,7 +293,7 @@ def _profiled(problem: _Problem, sol):
     lo, hi = problem.bounds()
     for _ in range(3):
         sd = _uncertainties(problem, sol)[2]
-        prof = profile(problem.residuals, sol.x, lo, hi, sd)
+        prof = profile(problem.residuals, sol.x, lo, hi, sd, many=problem.residuals_many)
         if prof.better is None:
             break
         moved = _solve(problem, [prof.better])

@@ -77,7 +77,8 @@ class _Exhausted(Exception):
 
 
 def minimise(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, iterations: tuple[int, int, int], *,
-             xtol: float, allowance: int | None = None) -> tuple[OptimizeResult | None, bool]:
+             xtol: float, allowance: int | None = None,
+             many: Callable[[list[np.ndarray]], list[np.ndarray]] | None = None) -> tuple[OptimizeResult | None, bool]:
     """Bounded least squares of ``fun`` from ``x0``, each stage bounded by its ``iterations``
     (function evaluations, the Jacobian's not counted): trust-region reflective; if it has not
     converged, dogbox from where it stopped; if that has not converged to a lower sum of squares
@@ -90,19 +91,28 @@ def minimise(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, iteratio
     With ``allowance``, at most that many evaluations of ``fun`` in all (an iteration and its
     finite-difference Jacobian cost at most 1 + len(x0)). Returns the solution and whether the
     allowance cut an unconverged search short (the solution None if nothing was allowed).
-    Raises ValueError where ``fun`` is not finite at ``x0``."""
+    Raises ValueError where ``fun`` is not finite at ``x0``.
+
+    ``many``, if given, is ``fun`` of several points at once (a list of them, the same numbers):
+    the finite-difference Jacobian's columns are computed by it in one call (least_squares'
+    ``workers``), each still counted as an evaluation."""
     spent = [0]
 
     def counted(x):
         spent[0] += 1
         return fun(x)
 
+    def columns(_fun, points):
+        points = list(points)
+        spent[0] += len(points)
+        return many(points)
+
     def stage(method, x, most):
         allowed = most if allowance is None else min(most, (allowance - spent[0]) // (np.size(x0) + 1))
         if allowed < 1:
             return None, True
         sol = least_squares(counted, x, bounds=(lower, upper), method=method, x_scale="jac", xtol=xtol,
-                            ftol=1e-12, gtol=1e-12, max_nfev=allowed)
+                            ftol=1e-12, gtol=1e-12, max_nfev=allowed, workers=columns if many else None)
         return sol, sol.status == 0 and allowed < most
 
     first, cut = stage("trf", np.asarray(x0, dtype=float), iterations[0])
@@ -142,11 +152,13 @@ def linearised(jac: np.ndarray, sum_of_squares: float, names, values: dict[str, 
 
 
 def profile(residuals: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, lower, upper,
-            step, *, confidence: float = CONFIDENCE, evaluations: int = SIDE_EVALUATIONS) -> Profile:
+            step, *, confidence: float = CONFIDENCE, evaluations: int = SIDE_EVALUATIONS,
+            many: Callable[[list[np.ndarray]], list[np.ndarray]] | None = None) -> Profile:
     """Profile every parameter of the least-squares problem ``residuals`` about its optimum
     ``theta`` within the bounds; ``step`` gives each parameter's first step (for example its
     linearised standard error, in the same coordinates). At most ``evaluations`` evaluations of
-    ``residuals`` per side, and one at the optimum."""
+    ``residuals`` per side, and one at the optimum. ``many``: ``residuals`` of several points at
+    once, for the refits' Jacobians (:func:`minimise`)."""
     theta = np.asarray(theta, dtype=float)
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     r0 = residuals(theta)
@@ -155,7 +167,7 @@ def profile(residuals: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, lo
     dof = max(n - p, 1)
     s2 = max(s_min / dof, NOISE_FLOOR**2)
     threshold = s2 * float(f_distribution.ppf(confidence, 1, dof))
-    walker = _Walker(residuals, theta, lower, upper, s_min, threshold)
+    walker = _Walker(residuals, theta, lower, upper, s_min, threshold, many)
     intervals, complete = [], True
     for j in range(p):
         sides = []
@@ -176,8 +188,9 @@ def _first_step(step: float, span: float) -> float:
 
 
 class _Walker:
-    def __init__(self, residuals, theta, lower, upper, s_min, threshold):
+    def __init__(self, residuals, theta, lower, upper, s_min, threshold, many=None):
         self.residuals, self.theta, self.lower, self.upper = residuals, theta, lower, upper
+        self.many = many
         self.s_min, self.threshold = s_min, threshold
         self.better: np.ndarray | None = None
         self.best_s = s_min
@@ -219,9 +232,13 @@ class _Walker:
                     spent[0] += 1
                     return self.residuals(full(x))
 
+                def fun_many(xs, spent=spent):
+                    spent[0] += len(xs)
+                    return self.many([full(x) for x in xs])
+
                 try:
                     sol, cut = minimise(fun, np.clip(x0, lo, hi), lo, hi, REFIT_NFEV, xtol=1e-10,
-                                           allowance=self.left)
+                                        allowance=self.left, many=fun_many if self.many else None)
                 except (ValueError, ArithmeticError):
                     self._charge(spent[0])
                     continue
