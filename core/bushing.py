@@ -29,6 +29,7 @@ from .design import Design
 from .effects import EFFECTS, branch_moduli, extended_modulus, inertia_correction, wave_stiffness
 from .parameters import MODE, THESIS_MODES
 from .parts import Material
+from .registry import parameter
 from .response import ComplexStiffness, loss_factor
 from .shape import shape_factor, strain_factor  # noqa: F401 (re-exported)
 from .slices import continuum_node_count, continuum_nodes, slice_nodes, solve_series
@@ -323,50 +324,68 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
     return np.array(k)
 
 
-def stiffness_points_many(designs, frequency_hz, amplitude) -> np.ndarray | None:
-    """:func:`stiffness_points` of several designs at once, shape (designs, *points), where they
-    differ only in their material's and effects' values (one mode, geometry, shape and set of
-    effects) and the route is the single equivalent modulus (eqs 14–18, with the material-level
-    effects, inertia and standing waves): the same formulas over arrays of parameters, one value
-    per design, so the same numbers. ``None`` where that is not so (the caller then evaluates
-    design by design): slices, the continuum (``nonuniform_strain``), designs that differ
-    otherwise. What a fit's finite-difference Jacobian needs: its columns change one parameter
-    each. Raises ValueError as :func:`stiffness_points` would for the first design it refuses."""
-    first = designs[0]
-    keys = [(d.mode, d.geometry, d.shape, tuple(eid for eid, _ in d.effects)) for d in designs]
-    effects = first.effect_parameters
-    if any(k != keys[0] for k in keys) or "nonuniform_strain" in effects:
-        return None
-    f, x = np.asarray(frequency_hz, float), np.asarray(amplitude, float)
-    shape = np.broadcast_shapes(f.shape, x.shape)
-    check_strain(first, x)
-    _check_series(first, 1)
-    n, ones = len(designs), (1,) * len(shape)
+class PointsModel:
+    """:func:`stiffness_points` of one design at fixed points (``frequency_hz``, ``amplitude``
+    broadcast; Hz, m or rad) for many values of some of its parameters at once, ``names``
+    (fitting names, :mod:`core.registry`: a material field, or ``effect_id.name`` of an effect
+    the design carries). Calling it with ``columns``, each name's array of n values within its
+    fitting range (ValueError otherwise), gives K shaped (n, *points): the same formulas over
+    arrays of parameters, so the same numbers as design by design. The design and the points are
+    checked once, here (as :func:`stiffness_points` checks them), not at every call: what a fit
+    asks at every evaluation, its finite-difference Jacobian's columns (one parameter changed in
+    each) at once.
 
-    def column(values) -> np.ndarray:
-        return np.array(values, dtype=float).reshape((n, *ones))
+    Only where the route is the single equivalent modulus (eqs 14–18, with the material-level
+    effects, inertia and standing waves): :attr:`usable` is False for slices, the continuum of
+    ``nonuniform_strain`` or an effect tied to another mode's rig (the caller then evaluates
+    design by design)."""
 
-    material = SimpleNamespace(**{name: column([getattr(d.material, name) for d in designs])
-                                  for name in _MATERIAL_FIELDS})
-    every = [d.effect_parameters for d in designs]
-    params = {eid: {p: column([e[eid][p] for e in every]) for p in effects[eid]} for eid in effects}
-    if any(EFFECTS[e].term is not None for e in effects):
-        modulus = functools.partial(extended_modulus, material, params)
-    else:
-        modulus = functools.partial(mat.equivalent_modulus, material)
-    s, c = factors(first)
-    if "wave_effects" in effects:
-        geo = first.geometry
-        k = wave_stiffness(first.mode, geo.inner_radius, geo.outer_radius, geo.length,
-                           modulus(f, first.strain(x)), f, params["wave_effects"]["density"])
-    else:
-        k = equivalent_stiffness(modulus, s, c, f, x)
-    if "inertia" in effects:
-        k = inertia_correction(k, f, params["inertia"]["mass"])
-    k = np.broadcast_to(k, (n, *shape))
-    if not np.all(np.isfinite(k)):
-        raise ValueError("the stiffness is not finite at these points (check the design's effects)")
-    return np.array(k)
+    def __init__(self, design: Design, names: tuple[str, ...], frequency_hz, amplitude):
+        self.design, self.names = design, tuple(names)
+        self.effects = design.effect_parameters
+        self.usable = "nonuniform_strain" not in self.effects and not any("@" in n for n in self.names)
+        self.f, self.x = np.asarray(frequency_hz, float), np.asarray(amplitude, float)
+        self.shape = np.broadcast_shapes(self.f.shape, self.x.shape)
+        if self.usable:
+            check_strain(design, self.x)
+            _check_series(design, 1)
+        self.bounds = [parameter(n).bounds for n in self.names]
+        self.factors = factors(design)
+        self.strain = design.strain(self.x)
+        self.terms = any(EFFECTS[e].term is not None for e in self.effects)
+
+    def __call__(self, columns: dict[str, np.ndarray]) -> np.ndarray:
+        if not self.usable:
+            raise ValueError("these points of this design are computed design by design (stiffness_points)")
+        n = len(columns[self.names[0]])
+        ones = (1,) * len(self.shape)
+        for name, (lo, hi) in zip(self.names, self.bounds):
+            if not np.all((columns[name] >= lo) & (columns[name] <= hi)):
+                raise ValueError(f"{name}: the values must lie within its fitting range {lo:g} to {hi:g}")
+
+        def value(name, scalar):
+            return np.asarray(columns[name], float).reshape((n, *ones)) if name in columns else scalar
+
+        material = SimpleNamespace(**{name: value(name, getattr(self.design.material, name))
+                                      for name in _MATERIAL_FIELDS})
+        params = {eid: {p: value(f"{eid}.{p}", v) for p, v in ps.items()} for eid, ps in self.effects.items()}
+        if self.terms:
+            modulus = functools.partial(extended_modulus, material, params)
+        else:
+            modulus = functools.partial(mat.equivalent_modulus, material)
+        f, x = self.f, self.x
+        if "wave_effects" in self.effects:
+            geo = self.design.geometry
+            k = wave_stiffness(self.design.mode, geo.inner_radius, geo.outer_radius, geo.length,
+                               modulus(f, self.strain), f, params["wave_effects"]["density"])
+        else:
+            k = equivalent_stiffness(modulus, *self.factors, f, x)
+        if "inertia" in self.effects:
+            k = inertia_correction(k, f, params["inertia"]["mass"])
+        k = np.broadcast_to(k, (n, *self.shape))
+        if not np.all(np.isfinite(k)):
+            raise ValueError("the stiffness is not finite at these points (check the design's effects)")
+        return np.array(k)
 
 
 _MATERIAL_FIELDS = tuple(f.name for f in dataclasses.fields(Material))

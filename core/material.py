@@ -123,11 +123,36 @@ def friction_modulus_universal(z):
 
 
 def friction_modulus(strain_amplitude, friction_stress_max: float, friction_strain_half: float):
-    """Friction modulus µ_f(ε̂) in Pa for the tensor strain amplitude ε̂ (docs/model.md, route 2)."""
+    """Friction modulus µ_f(ε̂) in Pa for the tensor strain amplitude ε̂ (docs/model.md, route 2).
+    ``friction_strain_half`` may be one value per design, shaped (n, 1, …) against ε̂."""
     eps = np.asarray(strain_amplitude, dtype=float)
-    return friction_stress_max / friction_strain_half * friction_modulus_universal(
-        eps / friction_strain_half
-    )
+    universal = _by_row(lambda half: friction_modulus_universal(eps / half), friction_strain_half, eps.shape)
+    if universal is None:
+        universal = friction_modulus_universal(eps / friction_strain_half)
+    return friction_stress_max / friction_strain_half * universal
+
+
+FEW_VALUES = 8  # a parameter of this few distinct values (per design) is computed value by value
+
+
+def _by_row(compute, values, shape):
+    """``compute(v)`` for each of the few distinct values v of a parameter given one value per
+    design (shaped (n, 1, …) against arguments of ``shape``), stacked to (n, …) in the designs'
+    order: each value's numbers computed once, and remembered (a finite-difference Jacobian's
+    columns share all but one value of each parameter). None where ``values`` is not so shaped or
+    has more than :data:`FEW_VALUES` distinct values (Monte Carlo samples)."""
+    values = np.asarray(values)
+    if values.ndim == 0 or values.size != values.shape[0] or values.ndim <= len(shape):
+        return None
+    listed = values.ravel().tolist()
+    distinct = dict.fromkeys(listed)
+    if len(distinct) > FEW_VALUES:
+        return None
+    out = np.broadcast_shapes(values.shape[1:], shape)
+    rows = {v: np.broadcast_to(compute(v), out) for v in distinct}
+    if len(listed) == 1:
+        return rows[listed[0]][None]
+    return np.stack([rows[v] for v in listed])
 
 
 def fractional_modulus(frequency_hz, fractional_coefficient: float, fractional_order: float):
@@ -141,7 +166,8 @@ def _fractional_power(frequency_hz, fractional_order):
     if np.ndim(fractional_order) == 0:
         return _remembered(("power", float(fractional_order)),
                            functools.partial(_power, float(fractional_order)), frequency_hz)
-    return _power(fractional_order, np.asarray(frequency_hz, dtype=float))
+    rows = _by_row(functools.partial(_fractional_power, frequency_hz), fractional_order, np.shape(frequency_hz))
+    return _power(fractional_order, np.asarray(frequency_hz, dtype=float)) if rows is None else rows
 
 
 def _power(fractional_order, frequency_hz):

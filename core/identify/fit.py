@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..bushing import check_measured_amplitude, stiffness_points, stiffness_points_many
+from ..bushing import PointsModel, check_measured_amplitude, stiffness_points
 from ..data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from ..design import Design
 from ..loops import loop_force
@@ -198,6 +198,13 @@ class _Problem:
         return lo, hi
 
     def residuals(self, theta) -> np.ndarray:
+        """The misfit at fitted coordinates ``theta``: the relative stiffness errors (real and
+        imaginary parts, weighted by the bins' counts), then the loop's force errors."""
+        if self._points() is not None:
+            return self.residuals_many([theta])[0]
+        return self._residuals(theta)
+
+    def _residuals(self, theta) -> np.ndarray:
         design = self.model(theta)
         parts = []
         if self.data is not None:
@@ -210,19 +217,25 @@ class _Problem:
         return _evaluable(np.concatenate(parts))
 
     def residuals_many(self, thetas: list[np.ndarray]) -> list[np.ndarray]:
-        """:meth:`residuals` at each of ``thetas``, the same numbers: the model of every point in
-        one evaluation (:func:`core.bushing.stiffness_points_many`) where it allows (stiffness
-        data of one mode, no loop), else point by point. What a finite-difference Jacobian asks."""
-        if self.data is None or self.loop is not None or self.data.mode is not None or len(thetas) < 2:
-            return [self.residuals(t) for t in thetas]
-        k = stiffness_points_many([self.model(t) for t in thetas], self.data.frequency_hz, self.data.amplitude)
-        if k is None:
-            return [self.residuals(t) for t in thetas]
-        out = []
-        for row in k:
-            r = relative_residual(row, self.data.stiffness) * self.data.weight
-            out.append(_evaluable(np.concatenate([r.real, r.imag])))
-        return out
+        """:meth:`residuals` at each of ``thetas``, the same numbers: the model at every point in
+        one evaluation (:class:`core.bushing.PointsModel`) where it allows (stiffness data of one
+        mode, no loop), else point by point. What a finite-difference Jacobian asks."""
+        points = self._points()
+        if points is None:
+            return [self._residuals(t) for t in thetas]
+        values = [self.values(t) for t in thetas]
+        k = points({name: np.array([v[name] for v in values]) for name in self.free})
+        r = relative_residual(k, self.data.stiffness) * self.data.weight
+        return list(_evaluable(np.concatenate([r.real, r.imag], axis=1)))
+
+    def _points(self) -> PointsModel | None:
+        """The model at the data's points, for many values of the free parameters at once; None
+        where it does not serve (a loop, data of several modes, the continuum)."""
+        if not hasattr(self, "_points_model"):
+            usable = self.data is not None and self.loop is None and self.data.mode is None
+            model = PointsModel(self.design, self.free, self.data.frequency_hz, self.data.amplitude) if usable else None
+            self._points_model = model if model is not None and model.usable else None
+        return self._points_model
 
 
 def _evaluable(r: np.ndarray) -> np.ndarray:
