@@ -41,9 +41,9 @@ def _remembered(key, compute, x):
     """``compute(x)`` for the float array ``x``, from the last :data:`REMEMBERED` results when
     the same ``key`` and the same exact bytes of ``x`` come again: identical numbers, as a copy.
     A fit's finite-difference Jacobian changes one parameter at a time, so most pieces of the
-    model repeat. Arrays of more than :data:`REMEMBERED_SIZE` values are computed afresh."""
+    model repeat. Single numbers and arrays of more than :data:`REMEMBERED_SIZE` values are computed afresh."""
     x = np.asarray(x, dtype=float)
-    if x.size > REMEMBERED_SIZE:
+    if x.ndim == 0 or x.size > REMEMBERED_SIZE:
         return compute(x)
     k = (key, x.shape, x.tobytes())
     with _MEMORY_LOCK:

@@ -78,7 +78,8 @@ class _Exhausted(Exception):
 
 def minimise(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, iterations: tuple[int, int, int], *,
              xtol: float, allowance: int | None = None,
-             many: Callable[[list[np.ndarray]], list[np.ndarray]] | None = None) -> tuple[OptimizeResult | None, bool]:
+             many: Callable[[list[np.ndarray]], list[np.ndarray]] | None = None,
+             callback: Callable[[OptimizeResult], None] | None = None) -> tuple[OptimizeResult | None, bool]:
     """Bounded least squares of ``fun`` from ``x0``, each stage bounded by its ``iterations``
     (function evaluations, the Jacobian's not counted): trust-region reflective; if it has not
     converged, dogbox from where it stopped; if that has not converged to a lower sum of squares
@@ -95,7 +96,8 @@ def minimise(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, iteratio
 
     ``many``, if given, is ``fun`` of several points at once (a list of them, the same numbers):
     the finite-difference Jacobian's columns are computed by it in one call (least_squares'
-    ``workers``), each still counted as an evaluation."""
+    ``workers``), each still counted as an evaluation. ``callback`` is least_squares' at every
+    iterate of every stage; raising StopIteration ends the search there (status −2)."""
     spent = [0]
 
     def counted(x):
@@ -112,7 +114,8 @@ def minimise(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, iteratio
         if allowed < 1:
             return None, True
         sol = least_squares(counted, x, bounds=(lower, upper), method=method, x_scale="jac", xtol=xtol,
-                            ftol=1e-12, gtol=1e-12, max_nfev=allowed, workers=columns if many else None)
+                            ftol=1e-12, gtol=1e-12, max_nfev=allowed, workers=columns if many else None,
+                            callback=callback)
         return sol, sol.status == 0 and allowed < most
 
     first, cut = stage("trf", np.asarray(x0, dtype=float), iterations[0])
