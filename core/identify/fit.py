@@ -172,6 +172,8 @@ class _Problem:
         self.loop = loop
         self.base = parameter_values(design)
         self.specs = [parameter(p) for p in free]
+        self.scales = [(s.log, s.bounds) for s in self.specs]
+        self.low, self.high = (np.array(b, dtype=float) for b in zip(*(s.bounds for s in self.specs)))
         if loop is not None:
             self.loop_f, self.loop_amp, phase = loop.harmonic()
             force = loop.force - np.mean(loop.force)
@@ -190,7 +192,7 @@ class _Problem:
     def values(self, theta) -> dict[str, float]:
         """Natural values of fitted coordinates, within the fitting ranges (exp(ln 10) is a hair
         above 10, which ε½'s range refuses)."""
-        return {p: _clip(math.exp(t) if s.log else t, s.bounds) for p, s, t in zip(self.free, self.specs, theta)}
+        return {p: _clip(math.exp(t) if log else t, bounds) for p, t, (log, bounds) in zip(self.free, theta, self.scales)}
 
     def model(self, theta) -> Design:
         return with_values(self.design, self.values(theta))
@@ -226,8 +228,8 @@ class _Problem:
         points = self._points()
         if points is None:
             return [self._residuals(t) for t in thetas]
-        values = [self.values(t) for t in thetas]
-        k = points({name: np.array([v[name] for v in values]) for name in self.free})
+        raw = np.array([[math.exp(t) if log else t for t, (log, _) in zip(theta, self.scales)] for theta in thetas])
+        k = points(np.minimum(np.maximum(raw, self.low), self.high))  # as _clip: NaN stays NaN
         r = relative_residual(k, self.data.stiffness) * self.data.weight
         return list(_evaluable(np.concatenate([r.real, r.imag], axis=1)))
 
