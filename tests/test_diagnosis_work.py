@@ -20,13 +20,14 @@ from core.synthetic import synthetic_stiffness
 # parameter sets of each call of core.bushing.PointsModel, a finite-difference Jacobian's columns
 # at once): 10,563 before the profile's crossings were interpolated (the final profile 3,242 of
 # them), 9,605 after (2,284); 6,315 once a start that joins an earlier start's path stops there
-# (the viscous candidate's three starts crept side by side, 3,476 evaluations; 1,295 now)
-MAX_EVALUATIONS = 6_600
-MAX_PROFILE_EVALUATIONS = 2_600
+# (the viscous candidate's three starts crept side by side, 3,476 evaluations; 1,295 now), 6,004
+# once the profile's refits start on the line through the path's last two points (1,973)
+MAX_EVALUATIONS = 6_400
+MAX_PROFILE_EVALUATIONS = 2_150
 MAX_CANDIDATE_EVALUATIONS = 1_500  # any one candidate's fit
 # passes of the model over the points (a Jacobian's columns one pass): 9,605 when each evaluation
-# was one, 2,225 with the columns together
-MAX_PASSES = 2_400
+# was one, 2,122 with the columns together
+MAX_PASSES = 2_300
 
 
 def test_the_150_point_diagnosis_stays_within_its_count_of_model_evaluations(monkeypatch):

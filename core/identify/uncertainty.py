@@ -190,6 +190,15 @@ def _first_step(step: float, span: float) -> float:
     return float(np.clip(step, span * FIRST_STEP[0], span * FIRST_STEP[1]))
 
 
+def _along(first, second, value: float) -> np.ndarray:
+    """The other parameters' start for a refit at ``value``: on the line through two points of
+    the profile's path, (value, others) each (a warm start a step ahead, which the path's
+    curvature alone keeps from being the answer); the second point's own if there is no first."""
+    if first is None or first[0] == second[0]:
+        return second[1]
+    return second[1] + (second[1] - first[1]) * ((value - second[0]) / (second[0] - first[0]))
+
+
 class _Walker:
     def __init__(self, residuals, theta, lower, upper, s_min, threshold, many=None):
         self.residuals, self.theta, self.lower, self.upper = residuals, theta, lower, upper
@@ -267,6 +276,7 @@ class _Walker:
         edge = self.lower[j] if direction < 0 else self.upper[j]
         span = self.upper[j] - self.lower[j]
         inside, x_in, rise_in = float(self.theta[j]), x_hat, 0.0
+        before = None  # the inside point before, (value, others): the path's slope
         for _ in range(MAX_STEPS):
             if abs(edge - inside) <= 1e-12 * max(span, 1.0):
                 return None  # the optimum sits at the bound: nothing beyond it to test
@@ -274,10 +284,11 @@ class _Walker:
             at_edge = direction * (value - edge) >= 0
             if at_edge:
                 value = edge
-            s, x = self.refit(j, value, [x_in, x_hat])
+            s, x = self.refit(j, value, [_along(before, (inside, x_in), value), x_hat])
             rise = s - self.s_min
             if rise > self.threshold:
                 return self._crossing(j, (inside, x_in, rise_in), (value, x, rise), x_hat)
+            before = (inside, x_in)
             inside, x_in, rise_in = value, x, max(rise, 0.0)
             if at_edge:
                 return None
@@ -296,21 +307,21 @@ class _Walker:
         bracket reached. The side's evaluations spent meanwhile end it: the crossing is
         interpolated in the bracket reached."""
         root_t = math.sqrt(self.threshold)
-        (a, xa, ra), (b, _, rb) = inner, outer
+        (a, xa, ra), (b, xb, rb) = inner, outer
         root_a, root_b = math.sqrt(ra), math.sqrt(rb)
         for _ in range(SECANTS):
             if root_b <= root_a:
                 break
             guess = a + (b - a) * (root_t - root_a) / (root_b - root_a)
             try:
-                s, x = self.refit(j, guess, [xa, x_hat])
+                s, x = self.refit(j, guess, [_along((a, xa), (b, xb), guess), x_hat])
             except _Exhausted:
                 return guess
             root = math.sqrt(max(s - self.s_min, 0.0))
             if abs(root - root_t) <= CROSSING_TOLERANCE * root_t:
                 return guess
             if root > root_t:
-                b, root_b = guess, root
+                b, xb, root_b = guess, x, root
             else:
                 a, xa, root_a = guess, x, root
         (a, xa, ra), (b, _, rb) = inner, outer
