@@ -43,14 +43,11 @@ from ..residuals import gap, gaps_by_mode, relative_residual
 from ..rules import decimal
 from ..sampling import latin_hypercube
 from ..shape import OutsideTable
-from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS, linearised, minimise, profile
+from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS, Paths, linearised, minimise, profile
 
 FIT_NFEV = (100, 100, 200)  # iterations from one start in the stages of uncertainty.minimise
 # a relative misfit beyond this is no fit, and its squares would overflow: not evaluable
 MAX_RESIDUAL = 1e100
-# a start within this fraction of each parameter's fitting span of an earlier start's iterate (at no
-# lower cost) has joined its path (:class:`_Paths`)
-MERGE = 1e-3
 
 
 def model_stiffness(design: Design, data: MeasuredStiffness) -> np.ndarray:
@@ -206,7 +203,7 @@ class _Problem:
         """The misfit at fitted coordinates ``theta``: the relative stiffness errors (real and
         imaginary parts, weighted by the bins' counts), then the loop's force errors."""
         if self._points() is not None:
-            return self.residuals_many([theta])[0]
+            return self._together([theta])[0]
         return self._residuals(theta)
 
     def _residuals(self, theta) -> np.ndarray:
@@ -225,11 +222,13 @@ class _Problem:
         """:meth:`residuals` at each of ``thetas``, the same numbers: the model at every point in
         one evaluation (:class:`core.bushing.PointsModel`) where it allows (stiffness data of one
         mode, no loop), else point by point. What a finite-difference Jacobian asks."""
-        points = self._points()
-        if points is None:
+        if self._points() is None:
             return [self._residuals(t) for t in thetas]
+        return self._together(thetas)
+
+    def _together(self, thetas) -> list[np.ndarray]:
         raw = np.array([[math.exp(t) if log else t for t, (log, _) in zip(theta, self.scales)] for theta in thetas])
-        k = points(np.minimum(np.maximum(raw, self.low), self.high))  # as _clip: NaN stays NaN
+        k = self._points()(np.minimum(np.maximum(raw, self.low), self.high))  # as _clip: NaN stays NaN
         r = relative_residual(k, self.data.stiffness) * self.data.weight
         return list(_evaluable(np.concatenate([r.real, r.imag], axis=1)))
 
@@ -279,40 +278,10 @@ def _starts(problem: _Problem, n: int, seed: int = 0) -> list[np.ndarray]:
     return starts
 
 
-class _Paths:
-    """The iterates of the starts searched so far (fitted coordinates and costs): a later start
-    that comes within :data:`MERGE` of an earlier iterate, at no lower cost, has joined that
-    start's path and will end where it ended (least squares never climbs, so no lower): its
-    search stops there. Measured: the three starts of a candidate whose parameter the data push
-    to the end of its range (integer-order viscous damping, µ to 100 Pa) crept side by side,
-    each for some 180 iterations."""
-
-    def __init__(self, lo, hi):
-        self.span = np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)
-        self.points, self.costs = np.empty((0, self.span.size)), np.empty(0)
-
-    def follow(self, walked: list):
-        """least_squares' callback for a new start: StopIteration where it joins an earlier
-        path; its iterates collected in ``walked`` (:meth:`add` them when it ends)."""
-        def callback(intermediate_result):
-            x, cost = intermediate_result.x, float(intermediate_result.cost)
-            if self.costs.size:
-                near = np.max(np.abs(self.points - x) / self.span, axis=1) <= MERGE
-                if np.any(near & (cost >= self.costs)):
-                    raise StopIteration
-            walked.append((np.array(x), cost))
-        return callback
-
-    def add(self, walked: list) -> None:
-        if walked:
-            self.points = np.vstack([self.points, [x for x, _ in walked]])
-            self.costs = np.concatenate([self.costs, [c for _, c in walked]])
-
-
 def _solve(problem: _Problem, starts: list[np.ndarray]):
     lo, hi = problem.bounds()
     best = None
-    paths = _Paths(lo, hi)
+    paths = Paths(lo, hi)
     for theta0 in starts:
         theta0 = np.clip(theta0, lo, hi)
         walked: list = []
