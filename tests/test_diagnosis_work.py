@@ -104,3 +104,32 @@ def test_the_profile_crossing_is_where_a_fine_search_puts_it():
             # fraction of its distance from the optimum
             assert end == pytest.approx(truth, abs=3 * CROSSING_TOLERANCE * abs(truth - fit.x[j]))
             assert not math.isclose(end, fit.x[j])
+
+
+@pytest.mark.parametrize("effects", [{}, {"inertia": {"mass": 0.4}}, {"viscous": {"viscosity": 80.0}},
+                                     {"strain_stiffening": {"stiffening": 3.0}},
+                                     {"rate_amplitude_coupling": {"rate_exponent": 0.1}},
+                                     {"wave_effects": {"density": 1100.0}}])
+def test_the_model_of_many_parameter_sets_at_once_gives_each_design_s_own_numbers(effects):
+    """core.bushing.PointsModel (a Jacobian's columns in one pass) against stiffness_points of each
+    design alone: the same numbers, bit for bit; values outside a fitting range refused."""
+    from core.bushing import PointsModel, stiffness_points
+    from core.registry import parameter, parameter_values, with_values
+
+    design = PAPER_B.replace(effects=effects)
+    names = tuple(parameter_values(design))
+    f = np.repeat(np.linspace(1, 100, 30), 5)
+    x = np.tile([0.013e-3, 0.04e-3, 0.1e-3, 0.17e-3, 0.35e-3], 30)
+    base = np.array([parameter_values(design)[n] for n in names])
+    rows = [base] + [base * np.where(np.arange(base.size) == j, 1.01, 1.0) for j in range(base.size)]
+    rows.append(base * 1.01)  # two rows alike: a parameter's values repeat, as in a Jacobian
+    rows.append(base * 1.01)
+    k = PointsModel(design, names, f, x)(np.array(rows))
+    for row, values in zip(k, rows):
+        alone = stiffness_points(with_values(design, dict(zip(names, values))), f, x)
+        assert np.array_equal(row, alone)
+    j = names.index("fractional_order")
+    high = np.array(rows[:1])
+    high[0, j] = parameter("fractional_order").bounds[1] * 1.5
+    with pytest.raises(ValueError, match="fractional_order"):
+        PointsModel(design, names, f, x)(high)
