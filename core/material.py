@@ -32,7 +32,7 @@ REFERENCE_FREQUENCY_HZ = 10.0  # rate_amplitude_coupling: µ_f · (f / 10 Hz)^γ
 # --------------------------------------------------------------------------------------------
 
 REMEMBERED = 64  # the last results of the costly pieces below kept, by their exact arguments
-REMEMBERED_SIZE = 4096  # for arguments of at most this many values (a fit's points, not grids)
+REMEMBERED_SIZE = 4096  # for a list of at most this many points (a fit's), not grids
 _MEMORY: OrderedDict = OrderedDict()
 _MEMORY_LOCK = threading.Lock()
 
@@ -41,9 +41,11 @@ def _remembered(key, compute, x):
     """``compute(x)`` for the float array ``x``, from the last :data:`REMEMBERED` results when
     the same ``key`` and the same exact bytes of ``x`` come again: identical numbers, as a copy.
     A fit's finite-difference Jacobian changes one parameter at a time, so most pieces of the
-    model repeat. Single numbers and arrays of more than :data:`REMEMBERED_SIZE` values are computed afresh."""
+    model repeat. Only a list of points is remembered (one dimension, at most
+    :data:`REMEMBERED_SIZE` values: a fit's); single numbers, grids and the slices' layers are
+    computed afresh."""
     x = np.asarray(x, dtype=float)
-    if x.ndim == 0 or x.size > REMEMBERED_SIZE:
+    if x.ndim != 1 or x.size > REMEMBERED_SIZE:
         return compute(x)
     k = (key, x.shape, x.tobytes())
     with _MEMORY_LOCK:
