@@ -1,6 +1,7 @@
 """Where the diagnosis of 150 points spends its work (issue #27, item 16): prints, per stage of
 :func:`core.identify.diagnose.diagnose`, the evaluations of the model (calls of
-:func:`core.bushing.stiffness_points`, each over the fit's points) and the CPU seconds
+:func:`core.bushing.stiffness_points`, each over the fit's points, and the parameter sets of each call of
+:class:`core.bushing.PointsModel`, a finite-difference Jacobian's columns at once) and the CPU seconds
 (``time.process_time``: the machine's load does not change them much, the wall clock's does).
 Asserts nothing.
 
@@ -45,11 +46,16 @@ def measure(data):
     counts: dict[str, list[float]] = defaultdict(lambda: [0, 0.0])
     current = ["start"]
     clock = [time.process_time()]
-    original = fit_module.stiffness_points
+    original, original_many = fit_module.stiffness_points, fit_module.PointsModel.__call__
 
     def counted(*args, **kwargs):
         counts[current[0]][0] += 1
         return original(*args, **kwargs)
+
+    def counted_many(*args, **kwargs):
+        k = original_many(*args, **kwargs)
+        counts[current[0]][0] += len(k)
+        return k
 
     def progress(_fraction, message):
         now = time.process_time()
@@ -57,11 +63,11 @@ def measure(data):
         clock[0] = now
         current[0] = stage_of(message)
 
-    fit_module.stiffness_points = counted
+    fit_module.stiffness_points, fit_module.PointsModel.__call__ = counted, counted_many
     try:
         result = diagnose(PAPER_B, data, progress=progress)
     finally:
-        fit_module.stiffness_points = original
+        fit_module.stiffness_points, fit_module.PointsModel.__call__ = original, original_many
     progress(1.0, "end")
     counts.pop("end", None)
     return dict(counts), result

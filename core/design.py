@@ -233,6 +233,10 @@ class Design:
         DesignError
             If a changed value breaks its rule (TypeError: a name that is no field).
         """
+        if changes and all(k in _MATERIAL_KEYS or k == "effects" for k in changes):
+            fast = self._values_replaced(changes)
+            if fast is not None:
+                return fast
         geo = {k: changes.pop(k) for k in list(changes) if k in _GEOMETRY_KEYS}
         mat = {k: changes.pop(k) for k in list(changes) if k in _MATERIAL_KEYS}
         current = {f.name: getattr(self, f.name) for f in fields(self)}
@@ -242,6 +246,24 @@ class Design:
         if mat:
             current["material"] = Material(**{**as_dict(self.material), **mat})
         return Design(**current)
+
+    def _values_replaced(self, changes: dict) -> Design | None:
+        """:meth:`replace` of material values and effect values only, the set of effects the
+        same: the new material and effects validated, the rest (mode, shape, geometry, name,
+        which have not changed) not checked again. What a fit asks at every evaluation. None
+        where the effects' ids change (the full :meth:`replace` then checks their ties)."""
+        effects = self.effects
+        if "effects" in changes:
+            effects = _frozen_effects(changes["effects"])
+            if [eid for eid, _ in effects] != [eid for eid, _ in self.effects]:
+                return None
+        mat = {k: v for k, v in changes.items() if k != "effects"}
+        material = Material(**{**as_dict(self.material), **mat}) if mat else self.material
+        new = object.__new__(Design)
+        new.__dict__.update(self.__dict__)
+        object.__setattr__(new, "material", material)
+        object.__setattr__(new, "effects", effects)
+        return new
 
     def to_dict(self) -> dict:
         """The design-file object of docs/files.md.

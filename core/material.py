@@ -14,6 +14,9 @@ amplitudes follow ε(t) = Im(ε̂ e^{iωt}), so Im µ_eq ≥ 0 means dissipation
 
 from __future__ import annotations
 
+import functools
+import threading
+from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -27,6 +30,35 @@ REFERENCE_FREQUENCY_HZ = 10.0  # rate_amplitude_coupling: µ_f · (f / 10 Hz)^γ
 # --------------------------------------------------------------------------------------------
 # Analytic steady-state route
 # --------------------------------------------------------------------------------------------
+
+REMEMBERED = 64  # the last results of the costly pieces below kept, by their exact arguments
+REMEMBERED_SIZE = 4096  # for a list of at most this many points (a fit's), not grids
+_MEMORY: OrderedDict = OrderedDict()
+_MEMORY_LOCK = threading.Lock()
+
+
+def _remembered(key, compute, x):
+    """``compute(x)`` for the float array ``x``, from the last :data:`REMEMBERED` results when
+    the same ``key`` and the same exact bytes of ``x`` come again: identical numbers, as a copy.
+    A fit's finite-difference Jacobian changes one parameter at a time, so most pieces of the
+    model repeat. Only a list of points is remembered (one dimension, at most
+    :data:`REMEMBERED_SIZE` values: a fit's); single numbers, grids and the slices' layers are
+    computed afresh."""
+    x = np.asarray(x, dtype=float)
+    if x.ndim != 1 or x.size > REMEMBERED_SIZE:
+        return compute(x)
+    k = (key, x.shape, x.tobytes())
+    with _MEMORY_LOCK:
+        hit = _MEMORY.get(k)
+        if hit is not None:
+            _MEMORY.move_to_end(k)
+            return hit.copy()
+    value = compute(x)
+    with _MEMORY_LOCK:
+        _MEMORY[k] = value
+        if len(_MEMORY) > REMEMBERED:
+            _MEMORY.popitem(last=False)
+    return value.copy()
 
 
 def friction_reversal_ratio(z):
@@ -56,6 +88,20 @@ def _log1p_remainder(q):
     return out
 
 
+def _universal(z):
+    """g(z) computed: :func:`friction_modulus_universal` without its cache."""
+    z = np.asarray(z, dtype=float)
+    x = friction_reversal_ratio(z)
+    c = 1.0 + x
+    cz = c + z
+    s = np.sqrt(c * (c + 2.0 * z)) / cz
+    real = c * c / (cz * cz * s * (1.0 + s))
+    h = x * (x + z) - c * _log1p_remainder(2.0 * z / c)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        imag = np.where(z > 0, (2.0 / np.pi) * h / z, 0.0)
+    return real + 1j * imag
+
+
 def friction_modulus_universal(z):
     """Universal friction modulus g(z), with µ_f(ε̂) = (σ_fmax/ε½) · g(ε̂/ε½) (docs/model.md).
 
@@ -71,31 +117,64 @@ def friction_modulus_universal(z):
     Im g → 2/(π z) as z → ∞ (the Coulomb square loop). Im g ≥ 0.
 
     Parameters: z, array-like, dimensionless amplitude ε̂/ε½ > 0. Returns complex array.
+
+    The last values are remembered (:func:`_remembered`): a fit's finite-difference Jacobian
+    changes one parameter at a time, and z = ε̂/ε½ only when ε½ changes.
     """
-    z = np.asarray(z, dtype=float)
-    x = friction_reversal_ratio(z)
-    c = 1.0 + x
-    cz = c + z
-    s = np.sqrt(c * (c + 2.0 * z)) / cz
-    real = c * c / (cz * cz * s * (1.0 + s))
-    h = x * (x + z) - c * _log1p_remainder(2.0 * z / c)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        imag = np.where(z > 0, (2.0 / np.pi) * h / z, 0.0)
-    return real + 1j * imag
+    return _remembered("universal", _universal, z)
 
 
 def friction_modulus(strain_amplitude, friction_stress_max: float, friction_strain_half: float):
-    """Friction modulus µ_f(ε̂) in Pa for the tensor strain amplitude ε̂ (docs/model.md, route 2)."""
+    """Friction modulus µ_f(ε̂) in Pa for the tensor strain amplitude ε̂ (docs/model.md, route 2).
+    ``friction_strain_half`` may be one value per design, shaped (n, 1, …) against ε̂."""
     eps = np.asarray(strain_amplitude, dtype=float)
-    return friction_stress_max / friction_strain_half * friction_modulus_universal(
-        eps / friction_strain_half
-    )
+    universal = _by_row(lambda half: friction_modulus_universal(eps / half), friction_strain_half, eps.shape)
+    if universal is None:
+        universal = friction_modulus_universal(eps / friction_strain_half)
+    return friction_stress_max / friction_strain_half * universal
+
+
+FEW_VALUES = 8  # a parameter of this few distinct values (per design) is computed value by value
+
+
+def _by_row(compute, values, shape):
+    """``compute(v)`` for each of the few distinct values v of a parameter given one value per
+    design (shaped (n, 1, …) against arguments of ``shape``), stacked to (n, …) in the designs'
+    order: each value's numbers computed once, and remembered (a finite-difference Jacobian's
+    columns share all but one value of each parameter). None where ``values`` is not so shaped or
+    has more than :data:`FEW_VALUES` distinct values (Monte Carlo samples)."""
+    values = np.asarray(values)
+    if values.ndim == 0 or values.size != values.shape[0] or values.ndim <= len(shape):
+        return None
+    listed = values.ravel().tolist()
+    distinct = dict.fromkeys(listed)
+    if len(distinct) > FEW_VALUES:
+        return None
+    out = np.broadcast_shapes(values.shape[1:], shape)
+    rows = {v: np.broadcast_to(compute(v), out) for v in distinct}
+    if len(listed) == 1:
+        return rows[listed[0]][None]
+    return np.stack([rows[v] for v in listed])
 
 
 def fractional_modulus(frequency_hz, fractional_coefficient: float, fractional_order: float):
     """Fractional-branch modulus m (iω)^α / 2 in Pa (eq 5 over 2, since σ = 2µε)."""
+    return fractional_coefficient * _fractional_power(frequency_hz, fractional_order) / 2.0  # eqs 2, 5
+
+
+def _fractional_power(frequency_hz, fractional_order):
+    """(iω)^α, remembered for a scalar α (:func:`_remembered`): a fit's finite-difference
+    Jacobian changes α in one column of its five or more."""
+    if np.ndim(fractional_order) == 0:
+        return _remembered(("power", float(fractional_order)),
+                           functools.partial(_power, float(fractional_order)), frequency_hz)
+    rows = _by_row(functools.partial(_fractional_power, frequency_hz), fractional_order, np.shape(frequency_hz))
+    return _power(fractional_order, np.asarray(frequency_hz, dtype=float)) if rows is None else rows
+
+
+def _power(fractional_order, frequency_hz):
     omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
-    return fractional_coefficient * (1j * omega) ** fractional_order / 2.0  # eqs 2, 5
+    return (1j * omega) ** fractional_order
 
 
 def equivalent_modulus(material: Material, frequency_hz, strain_amplitude):

@@ -27,15 +27,21 @@ EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 @pytest.fixture
 def evaluations(monkeypatch):
-    """Counts every evaluation of a fit's residuals (the model at every data point): the work."""
+    """Counts every evaluation of a fit's residuals (the model at every data point): the work,
+    a finite-difference Jacobian's columns evaluated together (_Problem.residuals_many) each one."""
     count = [0]
-    residuals = fit_module._Problem.residuals
+    residuals, many = fit_module._Problem.residuals, fit_module._Problem.residuals_many
 
     def counted(self, theta):
         count[0] += 1
         return residuals(self, theta)
 
+    def counted_many(self, thetas):
+        count[0] += len(thetas)
+        return many(self, thetas)
+
     monkeypatch.setattr(fit_module._Problem, "residuals", counted)
+    monkeypatch.setattr(fit_module._Problem, "residuals_many", counted_many)
     return count
 
 

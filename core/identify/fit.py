@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..bushing import check_measured_amplitude, stiffness_points
+from ..bushing import PointsModel, check_measured_amplitude, stiffness_points
 from ..data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from ..design import Design
 from ..loops import loop_force
@@ -43,7 +43,7 @@ from ..residuals import gap, gaps_by_mode, relative_residual
 from ..rules import decimal
 from ..sampling import latin_hypercube
 from ..shape import OutsideTable
-from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS, linearised, minimise, profile
+from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS, Paths, linearised, minimise, profile
 
 FIT_NFEV = (100, 100, 200)  # iterations from one start in the stages of uncertainty.minimise
 # a relative misfit beyond this is no fit, and its squares would overflow: not evaluable
@@ -169,6 +169,8 @@ class _Problem:
         self.loop = loop
         self.base = parameter_values(design)
         self.specs = [parameter(p) for p in free]
+        self.scales = [(s.log, s.bounds) for s in self.specs]
+        self.low, self.high = (np.array(b, dtype=float) for b in zip(*(s.bounds for s in self.specs)))
         if loop is not None:
             self.loop_f, self.loop_amp, phase = loop.harmonic()
             force = loop.force - np.mean(loop.force)
@@ -187,7 +189,7 @@ class _Problem:
     def values(self, theta) -> dict[str, float]:
         """Natural values of fitted coordinates, within the fitting ranges (exp(ln 10) is a hair
         above 10, which ε½'s range refuses)."""
-        return {p: _clip(math.exp(t) if s.log else t, s.bounds) for p, s, t in zip(self.free, self.specs, theta)}
+        return {p: _clip(math.exp(t) if log else t, bounds) for p, t, (log, bounds) in zip(self.free, theta, self.scales)}
 
     def model(self, theta) -> Design:
         return with_values(self.design, self.values(theta))
@@ -198,6 +200,13 @@ class _Problem:
         return lo, hi
 
     def residuals(self, theta) -> np.ndarray:
+        """The misfit at fitted coordinates ``theta``: the relative stiffness errors (real and
+        imaginary parts, weighted by the bins' counts), then the loop's force errors."""
+        if self._points() is not None:
+            return self._together([theta])[0]
+        return self._residuals(theta)
+
+    def _residuals(self, theta) -> np.ndarray:
         design = self.model(theta)
         parts = []
         if self.data is not None:
@@ -207,8 +216,35 @@ class _Problem:
         if self.loop is not None:
             f = sum(loop_force(design, self.loop_f, self.loop_amp, self.loop_phase))
             parts.append(self.loop_weight * (f - self.loop_force) / self.loop_scale)
-        r = np.concatenate(parts)
-        return np.where(np.abs(r) <= MAX_RESIDUAL, r, np.inf)  # NaN too: not evaluable there
+        return _evaluable(np.concatenate(parts))
+
+    def residuals_many(self, thetas: list[np.ndarray]) -> list[np.ndarray]:
+        """:meth:`residuals` at each of ``thetas``, the same numbers: the model at every point in
+        one evaluation (:class:`core.bushing.PointsModel`) where it allows (stiffness data of one
+        mode, no loop), else point by point. What a finite-difference Jacobian asks."""
+        if self._points() is None:
+            return [self._residuals(t) for t in thetas]
+        return self._together(thetas)
+
+    def _together(self, thetas) -> list[np.ndarray]:
+        raw = np.array([[math.exp(t) if log else t for t, (log, _) in zip(theta, self.scales)] for theta in thetas])
+        k = self._points()(np.minimum(np.maximum(raw, self.low), self.high))  # as _clip: NaN stays NaN
+        r = relative_residual(k, self.data.stiffness) * self.data.weight
+        return list(_evaluable(np.concatenate([r.real, r.imag], axis=1)))
+
+    def _points(self) -> PointsModel | None:
+        """The model at the data's points, for many values of the free parameters at once; None
+        where it does not serve (a loop, data of several modes, the continuum)."""
+        if not hasattr(self, "_points_model"):
+            usable = self.data is not None and self.loop is None and self.data.mode is None
+            model = PointsModel(self.design, self.free, self.data.frequency_hz, self.data.amplitude) if usable else None
+            self._points_model = model if model is not None and model.usable else None
+        return self._points_model
+
+
+def _evaluable(r: np.ndarray) -> np.ndarray:
+    """Residuals beyond :data:`MAX_RESIDUAL` (NaN too) infinite: the model is not evaluable there."""
+    return np.where(np.abs(r) <= MAX_RESIDUAL, r, np.inf)
 
 
 def _uncertainties(problem: _Problem, sol) -> tuple[dict, dict, np.ndarray]:
@@ -245,12 +281,18 @@ def _starts(problem: _Problem, n: int, seed: int = 0) -> list[np.ndarray]:
 def _solve(problem: _Problem, starts: list[np.ndarray]):
     lo, hi = problem.bounds()
     best = None
+    paths = Paths(lo, hi)
     for theta0 in starts:
         theta0 = np.clip(theta0, lo, hi)
+        walked: list = []
         try:
-            sol, _ = minimise(problem.residuals, theta0, lo, hi, FIT_NFEV, xtol=1e-12)
+            sol, _ = minimise(problem.residuals, theta0, lo, hi, FIT_NFEV, xtol=1e-12, many=problem.residuals_many,
+                              callback=paths.follow(walked))
         except (ValueError, FloatingPointError, OverflowError):
             continue  # a start the model cannot evaluate: try the next
+        paths.add(walked)
+        if sol.status == -2:
+            continue  # it joined an earlier start's path: it ends no lower
         if np.all(np.isfinite(sol.fun)) and (best is None or sol.cost < best.cost):
             best = sol
     if best is None:
@@ -274,7 +316,7 @@ def _profiled(problem: _Problem, sol):
     lo, hi = problem.bounds()
     for _ in range(3):
         sd = _uncertainties(problem, sol)[2]
-        prof = profile(problem.residuals, sol.x, lo, hi, sd)
+        prof = profile(problem.residuals, sol.x, lo, hi, sd, many=problem.residuals_many)
         if prof.better is None:
             break
         moved = _solve(problem, [prof.better])

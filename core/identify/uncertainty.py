@@ -57,6 +57,9 @@ REFIT_NFEV = (20, 40, 100)
 # absurd designs' included, take at most about 1600; at under a millisecond each (a fit's binned
 # points) a side takes at most a few seconds
 SIDE_EVALUATIONS = 3000
+# a start within this fraction of each parameter's span of an earlier start's iterate (at no lower
+# cost) has joined its path (:class:`Paths`)
+MERGE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -77,7 +80,9 @@ class _Exhausted(Exception):
 
 
 def minimise(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, iterations: tuple[int, int, int], *,
-             xtol: float, allowance: int | None = None) -> tuple[OptimizeResult | None, bool]:
+             xtol: float, allowance: int | None = None,
+             many: Callable[[list[np.ndarray]], list[np.ndarray]] | None = None,
+             callback: Callable[[OptimizeResult], None] | None = None) -> tuple[OptimizeResult | None, bool]:
     """Bounded least squares of ``fun`` from ``x0``, each stage bounded by its ``iterations``
     (function evaluations, the Jacobian's not counted): trust-region reflective; if it has not
     converged, dogbox from where it stopped; if that has not converged to a lower sum of squares
@@ -90,19 +95,30 @@ def minimise(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, iteratio
     With ``allowance``, at most that many evaluations of ``fun`` in all (an iteration and its
     finite-difference Jacobian cost at most 1 + len(x0)). Returns the solution and whether the
     allowance cut an unconverged search short (the solution None if nothing was allowed).
-    Raises ValueError where ``fun`` is not finite at ``x0``."""
+    Raises ValueError where ``fun`` is not finite at ``x0``.
+
+    ``many``, if given, is ``fun`` of several points at once (a list of them, the same numbers):
+    the finite-difference Jacobian's columns are computed by it in one call (least_squares'
+    ``workers``), each still counted as an evaluation. ``callback`` is least_squares' at every
+    iterate of every stage; raising StopIteration ends the search there (status −2)."""
     spent = [0]
 
     def counted(x):
         spent[0] += 1
         return fun(x)
 
+    def columns(_fun, points):
+        points = list(points)
+        spent[0] += len(points)
+        return many(points)
+
     def stage(method, x, most):
         allowed = most if allowance is None else min(most, (allowance - spent[0]) // (np.size(x0) + 1))
         if allowed < 1:
             return None, True
         sol = least_squares(counted, x, bounds=(lower, upper), method=method, x_scale="jac", xtol=xtol,
-                            ftol=1e-12, gtol=1e-12, max_nfev=allowed)
+                            ftol=1e-12, gtol=1e-12, max_nfev=allowed, workers=columns if many else None,
+                            callback=callback)
         return sol, sol.status == 0 and allowed < most
 
     first, cut = stage("trf", np.asarray(x0, dtype=float), iterations[0])
@@ -118,6 +134,36 @@ def minimise(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, iteratio
     if third is None:
         return better, True
     return (third if third.cost < better.cost else better), cut and third.status == 0
+
+
+class Paths:
+    """The iterates of the starts searched so far (fitted coordinates and costs): a later start
+    that comes within :data:`MERGE` of an earlier iterate, at no lower cost, has joined that
+    start's path and will end where it ended (least squares never climbs, so no lower): its
+    search stops there. Measured: the three starts of a candidate whose parameter the data push
+    to the end of its range (integer-order viscous damping, µ to 100 Pa) crept side by side,
+    each for some 180 iterations."""
+
+    def __init__(self, lo, hi):
+        self.span = np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)
+        self.points, self.costs = np.empty((0, self.span.size)), np.empty(0)
+
+    def follow(self, walked: list):
+        """least_squares' callback for a new start: StopIteration where it joins an earlier
+        path; its iterates collected in ``walked`` (:meth:`add` them when it ends)."""
+        def callback(intermediate_result):
+            x, cost = intermediate_result.x, float(intermediate_result.cost)
+            if self.costs.size:
+                near = np.max(np.abs(self.points - x) / self.span, axis=1) <= MERGE
+                if np.any(near & (cost >= self.costs)):
+                    raise StopIteration
+            walked.append((np.array(x), cost))
+        return callback
+
+    def add(self, walked: list) -> None:
+        if walked:
+            self.points = np.vstack([self.points, [x for x, _ in walked]])
+            self.costs = np.concatenate([self.costs, [c for _, c in walked]])
 
 
 def linearised(jac: np.ndarray, sum_of_squares: float, names, values: dict[str, float],
@@ -142,11 +188,13 @@ def linearised(jac: np.ndarray, sum_of_squares: float, names, values: dict[str, 
 
 
 def profile(residuals: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, lower, upper,
-            step, *, confidence: float = CONFIDENCE, evaluations: int = SIDE_EVALUATIONS) -> Profile:
+            step, *, confidence: float = CONFIDENCE, evaluations: int = SIDE_EVALUATIONS,
+            many: Callable[[list[np.ndarray]], list[np.ndarray]] | None = None) -> Profile:
     """Profile every parameter of the least-squares problem ``residuals`` about its optimum
     ``theta`` within the bounds; ``step`` gives each parameter's first step (for example its
     linearised standard error, in the same coordinates). At most ``evaluations`` evaluations of
-    ``residuals`` per side, and one at the optimum."""
+    ``residuals`` per side, and one at the optimum. ``many``: ``residuals`` of several points at
+    once, for the refits' Jacobians (:func:`minimise`)."""
     theta = np.asarray(theta, dtype=float)
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     r0 = residuals(theta)
@@ -155,7 +203,7 @@ def profile(residuals: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, lo
     dof = max(n - p, 1)
     s2 = max(s_min / dof, NOISE_FLOOR**2)
     threshold = s2 * float(f_distribution.ppf(confidence, 1, dof))
-    walker = _Walker(residuals, theta, lower, upper, s_min, threshold)
+    walker = _Walker(residuals, theta, lower, upper, s_min, threshold, many)
     intervals, complete = [], True
     for j in range(p):
         sides = []
@@ -175,9 +223,19 @@ def _first_step(step: float, span: float) -> float:
     return float(np.clip(step, span * FIRST_STEP[0], span * FIRST_STEP[1]))
 
 
+def _along(first, second, value: float) -> np.ndarray:
+    """The other parameters' start for a refit at ``value``: on the line through two points of
+    the profile's path, (value, others) each (a warm start a step ahead, which the path's
+    curvature alone keeps from being the answer); the second point's own if there is no first."""
+    if first is None or first[0] == second[0]:
+        return second[1]
+    return second[1] + (second[1] - first[1]) * ((value - second[0]) / (second[0] - first[0]))
+
+
 class _Walker:
-    def __init__(self, residuals, theta, lower, upper, s_min, threshold):
+    def __init__(self, residuals, theta, lower, upper, s_min, threshold, many=None):
         self.residuals, self.theta, self.lower, self.upper = residuals, theta, lower, upper
+        self.many = many
         self.s_min, self.threshold = s_min, threshold
         self.better: np.ndarray | None = None
         self.best_s = s_min
@@ -219,9 +277,13 @@ class _Walker:
                     spent[0] += 1
                     return self.residuals(full(x))
 
+                def fun_many(xs, spent=spent):
+                    spent[0] += len(xs)
+                    return self.many([full(x) for x in xs])
+
                 try:
                     sol, cut = minimise(fun, np.clip(x0, lo, hi), lo, hi, REFIT_NFEV, xtol=1e-10,
-                                           allowance=self.left)
+                                        allowance=self.left, many=fun_many if self.many else None)
                 except (ValueError, ArithmeticError):
                     self._charge(spent[0])
                     continue
@@ -247,6 +309,7 @@ class _Walker:
         edge = self.lower[j] if direction < 0 else self.upper[j]
         span = self.upper[j] - self.lower[j]
         inside, x_in, rise_in = float(self.theta[j]), x_hat, 0.0
+        before = None  # the inside point before, (value, others): the path's slope
         for _ in range(MAX_STEPS):
             if abs(edge - inside) <= 1e-12 * max(span, 1.0):
                 return None  # the optimum sits at the bound: nothing beyond it to test
@@ -254,10 +317,11 @@ class _Walker:
             at_edge = direction * (value - edge) >= 0
             if at_edge:
                 value = edge
-            s, x = self.refit(j, value, [x_in, x_hat])
+            s, x = self.refit(j, value, [_along(before, (inside, x_in), value), x_hat])
             rise = s - self.s_min
             if rise > self.threshold:
                 return self._crossing(j, (inside, x_in, rise_in), (value, x, rise), x_hat)
+            before = (inside, x_in)
             inside, x_in, rise_in = value, x, max(rise, 0.0)
             if at_edge:
                 return None
@@ -276,21 +340,21 @@ class _Walker:
         bracket reached. The side's evaluations spent meanwhile end it: the crossing is
         interpolated in the bracket reached."""
         root_t = math.sqrt(self.threshold)
-        (a, xa, ra), (b, _, rb) = inner, outer
+        (a, xa, ra), (b, xb, rb) = inner, outer
         root_a, root_b = math.sqrt(ra), math.sqrt(rb)
         for _ in range(SECANTS):
             if root_b <= root_a:
                 break
             guess = a + (b - a) * (root_t - root_a) / (root_b - root_a)
             try:
-                s, x = self.refit(j, guess, [xa, x_hat])
+                s, x = self.refit(j, guess, [_along((a, xa), (b, xb), guess), x_hat])
             except _Exhausted:
                 return guess
             root = math.sqrt(max(s - self.s_min, 0.0))
             if abs(root - root_t) <= CROSSING_TOLERANCE * root_t:
                 return guess
             if root > root_t:
-                b, root_b = guess, root
+                b, xb, root_b = guess, x, root
             else:
                 a, xa, root_a = guess, x, root
         (a, xa, ra), (b, _, rb) = inner, outer
