@@ -15,14 +15,13 @@ amplitudes follow ε(t) = Im(ε̂ e^{iωt}), so Im µ_eq ≥ 0 means dissipation
 from __future__ import annotations
 
 import functools
-import threading
-from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.signal import oaconvolve
 
+from .memo import remembered as _remembered
 from .parts import Material
 
 REFERENCE_FREQUENCY_HZ = 10.0  # rate_amplitude_coupling: µ_f · (f / 10 Hz)^γ
@@ -30,36 +29,6 @@ REFERENCE_FREQUENCY_HZ = 10.0  # rate_amplitude_coupling: µ_f · (f / 10 Hz)^γ
 # --------------------------------------------------------------------------------------------
 # Analytic steady-state route
 # --------------------------------------------------------------------------------------------
-
-REMEMBERED = 64  # the last results of the costly pieces below kept, by their exact arguments
-REMEMBERED_SIZE = 4096  # for a list of at most this many points (a fit's), not grids
-_MEMORY: OrderedDict = OrderedDict()
-_MEMORY_LOCK = threading.Lock()
-
-
-def _remembered(key, compute, x):
-    """``compute(x)`` for the float array ``x``, from the last :data:`REMEMBERED` results when
-    the same ``key`` and the same exact bytes of ``x`` come again: identical numbers, as a copy.
-    A fit's finite-difference Jacobian changes one parameter at a time, so most pieces of the
-    model repeat. Only a list of points is remembered (one dimension, at most
-    :data:`REMEMBERED_SIZE` values: a fit's); single numbers, grids and the slices' layers are
-    computed afresh."""
-    x = np.asarray(x, dtype=float)
-    if x.ndim != 1 or x.size > REMEMBERED_SIZE:
-        return compute(x)
-    k = (key, x.shape, x.tobytes())
-    with _MEMORY_LOCK:
-        hit = _MEMORY.get(k)
-        if hit is not None:
-            _MEMORY.move_to_end(k)
-            return hit.copy()
-    value = compute(x)
-    with _MEMORY_LOCK:
-        _MEMORY[k] = value
-        if len(_MEMORY) > REMEMBERED:
-            _MEMORY.popitem(last=False)
-    return value.copy()
-
 
 def friction_reversal_ratio(z):
     """Steady turning-point friction stress in units of σ_fmax, for amplitude z = ε̂/ε½.
