@@ -10,7 +10,8 @@ loaded, the document's pending work done): it stores that result as the tab does
 ends (one held change) and serializes the held changes as the server's ``PATCH-DOC`` message.
 It prints the CPU time (``time.process_time``: this process only, other jobs on the machine do
 not count) of the first report of a session (what every page pays) and of a second one in the
-same session, with the Bokeh models each creates and the message's size. ``--profile`` adds
+same session, with the Bokeh models each creates and the message's size, and the CPU time of
+loading the data (what the tab makes ready for the report is made then). ``--profile`` adds
 cProfile's 25 costliest functions (cumulative) over the first reports.
 """
 
@@ -52,8 +53,10 @@ def session(csv: str):
     with set_curdoc(doc):
         app.template().server_doc(doc)
         app.tabs.active = next(i for i, (_t, name, _b) in enumerate(app.LAZY_TABS, 1) if name == "diagnosis")
+        t0 = time.process_time()
         assert app.diagnosis.state.load_csv(csv, "inertia.csv")
         drain(doc)
+        app.load_ms = 1e3 * (time.process_time() - t0)
     return app, doc
 
 
@@ -116,12 +119,15 @@ def main(runs: int, profile: bool):
     result = app.diagnosis.state.compute()
     print(f"diagnosis of 150 points: {time.process_time() - t0:.2f} s CPU (once; not counted below)")
     prof = cProfile.Profile() if profile else None
-    first, second = [], []
+    first, second, load = [], [], []
     report(*session(csv), result)  # warm: imports and caches
     for _ in range(runs):
         app, doc = session(csv)
+        load.append(app.load_ms)
         first.append(report(app, doc, result, prof))
         second.append(report(app, doc, result))
+    print(f"  {'data loaded':<28} server CPU median {statistics.median(load):6.1f} ms (the upload's reading and "
+          "judging, and whatever the tab makes ready then)")
     for name, rows in (("first report of a session", first), ("second report, same session", second)):
         ms = [r[0] for r in rows]
         print(f"  {name:<28} server CPU median {statistics.median(ms):6.1f} ms (max {max(ms):6.1f}); "
