@@ -7,7 +7,7 @@ from __future__ import annotations
 import holoviews as hv
 import numpy as np
 
-from .. import curves
+from .. import curves, units
 from .style import (
     amplitude_curves,
     dimensions,
@@ -43,29 +43,31 @@ def diagnosis_curves(groups: list, dims: dict) -> dict:
 
 def misfit_map(m: dict, column: str, title: str, dims: dict, limit: float, png: str) -> hv.Overlay:
     """A misfit over the (frequency, amplitude) plane: one square per measured point, coloured
-    on a diverging scale from −``limit`` to +``limit`` (red: model above the data)."""
-    zdim = dims["misfit_magnitude" if column == "magnitude_pct" else "misfit_loss"]
+    on a diverging scale from −``limit`` to +``limit`` (red: model above the data). The scale is
+    the colour dimension's range (not an option): maps of one look with other limits are drawn
+    alike, their numbers written into the plot shown (:mod:`app.live`)."""
+    zdim = dims["misfit_magnitude" if column == "magnitude_pct" else "misfit_loss"].clone(range=(-limit, limit))
     pts = styled("Points", (np.asarray(m["frequency_hz"], dtype=float), np.asarray(m["amplitude"], dtype=float),
                             np.asarray(m[column], dtype=float)),
                  kdims=[dims["frequency"], dims["amplitude"]], vdims=[zdim], color=zdim.name, cmap="RdBu_r",
                  marker="square", size=11, colorbar=True, line_color="#777777", line_width=0.5,
-                 clim=(-limit, limit), tools=["hover"])
+                 tools=["hover"])
     return overlay([pts], title, png, logy=True, legend=None, height=260)
 
 
-def diagnosis_overlays(diagnosis) -> dict:
-    """The plots of a :class:`core.identify.diagnose.Diagnosis`: ``"gap"`` (one plot: the gap after each
-    step), ``"curves"`` (|K| and the loss factor: data, baseline, final model) and ``"maps"``
-    (the misfit before, then after: |K| and the loss factor each, on one colour scale per
-    quantity); ``"groups"`` the curves' amplitude groups (:func:`app.curves.curve_groups`)."""
-    stages = curves.gap_stages(diagnosis)
-    groups = curves.curve_groups(diagnosis)
-    base, final = curves.misfit_points(diagnosis, "baseline"), curves.misfit_points(diagnosis, "final")
-    ranges = {"gap": (0.0, 1.1 * max(float(np.max(stages["gap"])), stages["noise"] or 0.0)),
+def report_overlays(stages: dict, groups: list, misfits: dict, mode: str) -> dict:
+    """The report's plots from their data (display units): ``"gap"`` (one plot: the gap after each
+    step, ``stages`` as :func:`app.curves.gap_stages`), ``"curves"`` (|K| and the loss factor:
+    data, baseline, final model; ``groups`` as :func:`app.curves.curve_groups`) and ``"maps"``
+    (the misfit before, then after: |K| in % and the loss factor each, on one colour scale per
+    quantity; ``misfits``: "baseline" and "final", each as :func:`app.curves.misfit_points`);
+    ``"groups"`` the curves' amplitude groups."""
+    base, final = misfits["baseline"], misfits["final"]
+    ranges = {"gap": (0.0, 1.1 * max(float(np.max(stages["gap"])), stages["noise"] or 0.0) or 1.0),
               "amplitude": curves.padded([final["amplitude"]], log=True)}
     for i, quantity in enumerate(("magnitude", "loss_factor")):  # the data and both models in view
         ranges[quantity] = curves.padded([v for g in groups for v in (g["data"][i], g["baseline"][i], g["final"][i])])
-    dims = ranged(dimensions(diagnosis.final.design.mode), ranges)
+    dims = ranged(dimensions(mode), ranges)
     maps = []
     for which, m in (("baseline", base), ("final", final)):
         for column, name in (("magnitude_pct", "|K| misfit (%)"), ("loss_factor", "loss-factor misfit")):
@@ -74,6 +76,26 @@ def diagnosis_overlays(diagnosis) -> dict:
                                    f"bushing-misfit-{which}-{MISFIT_PNG[column]}"))
     return {"gap": [gap_bars(stages, dims)], "curves": list(diagnosis_curves(groups, dims).values()),
             "maps": maps, "groups": groups}
+
+
+def diagnosis_overlays(diagnosis) -> dict:
+    """The plots of a :class:`core.identify.diagnose.Diagnosis` (:func:`report_overlays`)."""
+    return report_overlays(curves.gap_stages(diagnosis), curves.curve_groups(diagnosis),
+                           {which: curves.misfit_points(diagnosis, which) for which in ("baseline", "final")},
+                           diagnosis.final.design.mode)
+
+
+def pending_overlays(data, mode: str) -> dict:
+    """The plots a diagnosis of ``data`` (a :class:`core.data.MeasuredStiffness`, the rows of ``mode``)
+    will have, before it has run: the report's elements, labels and styles (one curve per measured
+    amplitude), both models standing at the data and no misfit. Built while the data wait to be
+    diagnosed, so that the report's numbers are then written into plots that exist
+    (:meth:`app.live.LivePlot.show`); never shown."""
+    groups = curves.amplitude_groups(data, mode, {"baseline": data.stiffness, "final": data.stiffness})
+    none = {"frequency_hz": data.frequency_hz, "amplitude": units.display_amplitude(data.amplitude, mode),
+            "magnitude_pct": np.zeros(len(data)), "loss_factor": np.zeros(len(data))}
+    return report_overlays({"stage": ["baseline"], "gap": np.zeros(1), "noise": 0.0}, groups,
+                           {"baseline": none, "final": none}, mode)
 
 
 def diagnosis_plots(diagnosis, *, width: int | None = 560) -> hv.Layout:

@@ -18,7 +18,7 @@ from core.numbers import format_number, format_value
 from ..diagnosis_state import DiagnosisState
 from ..inputs import tip
 from ..live import LivePlot, one_change, update_or_keep
-from ..plotting.find_the_missing_effect import diagnosis_overlays
+from ..plotting.find_the_missing_effect import diagnosis_overlays, pending_overlays
 from ..plotting.style import SWEEP_PALETTES, sweep_label
 from ..shapes import shape_pane
 from ..units import amplitude_unit
@@ -107,6 +107,7 @@ class DiagnosisView(pn.viewable.Viewer):
         )
         state.param.watch(self._refresh, ["data", "source", "message", "note", "result", "running", "mystery", "revealed"])
         state.param.watch(self._on_progress, ["progress", "progress_message"])
+        state.param.watch(self._on_data, "data")
         self._refresh()
 
     # ---- events --------------------------------------------------------------------------------
@@ -142,6 +143,37 @@ class DiagnosisView(pn.viewable.Viewer):
         self.progress.value = round(100 * self.state.progress)
         self.progress_text.object = (f'<i class="diagnosis-progress">{self.state.progress_message}…</i>'
                                      if self.state.running else "")
+
+    def _on_data(self, *_events):
+        """New data: the report's plots are made ready for them once the data are on the page
+        (:meth:`_prepare`, on the next tick of a served page: the data's message goes first)."""
+        doc = pn.state.curdoc
+        if doc is not None and doc.session_context is not None:
+            doc.add_next_tick_callback(lambda: update_or_keep("DiagnosisView prepared no plots", self._prepare))
+        else:
+            update_or_keep("DiagnosisView prepared no plots", self._prepare)
+
+    def _prepare(self):
+        """The report's plots built (hidden) with the shape a diagnosis of the loaded data will give
+        them (:func:`app.plotting.find_the_missing_effect.pending_overlays`): the report then writes
+        its numbers into them (:meth:`app.live.LivePlot.show`) instead of HoloViews building seven
+        plots after the work (measured: ``benchmarks/diagnosis_report_cpu.py``)."""
+        s = self.state
+        data = None if s.data is None or s.running else s.data.of_mode(s.explorer.design.mode)
+        if data is None or len(data) == 0:
+            return
+        self._plots(pending_overlays(data, s.explorer.design.mode))
+
+    def _plots(self, overlays: dict):
+        """``overlays`` (as :func:`app.plotting.find_the_missing_effect.report_overlays`) shown in
+        the report's plots, built the first time."""
+        for name, cols in (("gap", 1), ("curves", 2), ("maps", 2)):
+            live = self.live.get(name)
+            if live is None:
+                self.live[name] = live = LivePlot(overlays[name])
+                self._plot_holders[name].objects = [live.grid(cols)]
+            else:
+                live.show(overlays[name])
 
     # ---- refresh -------------------------------------------------------------------------------
 
@@ -234,13 +266,7 @@ class DiagnosisView(pn.viewable.Viewer):
         self.curve_key.object = "Amplitudes: " + " ".join(
             f'<span style="color:{palette[i % len(palette)]};font-weight:bold">■ {sweep_label(g["amplitude"], unit)}</span>'
             for i, g in enumerate(overlays["groups"]))
-        for name, cols in (("gap", 1), ("curves", 2), ("maps", 2)):
-            live = self.live.get(name)
-            if live is None:
-                self.live[name] = live = LivePlot(overlays[name])
-                self._plot_holders[name].objects = [live.grid(cols)]
-            else:
-                live.show(overlays[name])
+        self._plots(overlays)
 
     def __panel__(self):
         return pn.Column(

@@ -1,0 +1,41 @@
+"""The diagnosis report in the browser (issue #27, item 16): its plots reach the page with the
+data, hidden, and the report's message brings numbers only, no new model. Each step waits for
+the state it then checks, never for a time."""
+
+import pytest
+from playwright.sync_api import TimeoutError as PlaywrightTimeout
+from playwright.sync_api import expect
+
+from tests.ui.bokeh_page import FIGURE_JS, open_explorer, plots, wait_plot
+from tests.ui.test_waiting_browser import upload_150_points
+
+pytestmark = pytest.mark.usefixtures("console_errors", "no_server_tracebacks")
+
+GAP = "Gap (relative RMS misfit of complex stiffness) after each step"
+REPORT_TITLES = (GAP, "|K|: data, baseline and final model", "Loss factor: data, baseline and final model",
+                 "Baseline: |K| misfit (%)", "Baseline: loss-factor misfit", "Final: |K| misfit (%)",
+                 "Final: loss-factor misfit")
+IDS_JS = "() => [...Bokeh.documents[0].all_models].map(m => m.id)"
+
+
+def test_the_reports_plots_come_with_the_data_and_the_report_adds_no_model(page, explorer_url, tmp_path):
+    """After the upload the page holds the report's seven figures (hidden: no report yet); the
+    report then changes their numbers and adds no model to the page (on 63e5360 the figures came
+    with the report, 560 new models after the work)."""
+    open_explorer(page, explorer_url)
+    upload_150_points(page, tmp_path)
+    try:
+        for title in REPORT_TITLES:
+            page.wait_for_function(f"(title) => ({FIGURE_JS})(title) !== null", arg=title, timeout=30_000)
+    except PlaywrightTimeout:
+        pytest.fail(f"the report's figures did not come with the data: {title!r} is not in the page")
+    expect(page.get_by_text("What the diagnosis found")).to_be_hidden()  # no report yet
+    page.wait_for_function("() => Bokeh.documents[0].is_idle")
+    before = set(page.evaluate(IDS_JS))
+    page.get_by_role("button", name="Diagnose").click()
+    page.get_by_text("What is left is noise", exact=True).wait_for(timeout=120_000)
+    wait_plot(page, GAP, "p.points === 2")  # baseline and + inertia
+    assert set(page.evaluate(IDS_JS)) <= before
+    shown = plots(page)
+    assert shown[GAP]["points"] == 2 and len(shown[GAP]["spans"]) == 1  # the bars, the noise line
+    assert shown["Final: |K| misfit (%)"]["points"] >= 150
