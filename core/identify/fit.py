@@ -26,7 +26,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -44,6 +44,10 @@ from ..rules import decimal
 from ..sampling import latin_hypercube
 from ..shape import OutsideTable
 from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS, linearised, minimise, profile
+
+# ``progress(fraction, message)``: where a fit is, in words ("start 2 of 8, evaluation 40")
+Progress = Callable[[float, str], None]
+PROGRESS_EVERY = 20  # evaluations of the model between two progress reports within a stage
 
 FIT_NFEV = (100, 100, 200)  # iterations from one start in the stages of uncertainty.minimise
 # a relative misfit beyond this is no fit, and its squares would overflow: not evaluable
@@ -242,13 +246,51 @@ def _starts(problem: _Problem, n: int, seed: int = 0) -> list[np.ndarray]:
     return starts
 
 
-def _solve(problem: _Problem, starts: list[np.ndarray]):
+def _reporting(residuals, progress: Progress | None, fraction: float, stage: str,
+               budget: int = 0, span: float = 0.0):
+    """``residuals`` that say ``progress(fraction, "STAGE, evaluation N")`` every
+    :data:`PROGRESS_EVERY` evaluations (``stage`` alone first), the fraction moving across
+    ``span`` as the evaluations near ``budget``; ``residuals`` itself without ``progress``."""
+    if progress is None:
+        return residuals
+    progress(fraction, stage)
+    spent = [0]
+
+    def counted(theta):
+        spent[0] += 1
+        if spent[0] % PROGRESS_EVERY == 0:
+            progress(fraction + span * min(spent[0] / max(budget, 1), 1.0), f"{stage}, evaluation {spent[0]}")
+        return residuals(theta)
+
+    return counted
+
+
+def _forward(progress: Progress | None) -> Progress | None:
+    """``progress`` told fractions that never go back (a refit after the profile restarts no
+    bar)."""
+    if progress is None:
+        return None
+    most = [0.0]
+
+    def told(fraction: float, message: str):
+        most[0] = max(most[0], min(fraction, 1.0))
+        progress(most[0], message)
+
+    return told
+
+
+def _solve(problem: _Problem, starts: list[np.ndarray], progress: Progress | None = None,
+           share: tuple[float, float] = (0.0, 0.6)):
+    """The best of the bounded least-squares searches from ``starts``; ``progress`` told which
+    start of how many runs, its fraction within ``share``."""
     lo, hi = problem.bounds()
     best = None
-    for theta0 in starts:
+    for i, theta0 in enumerate(starts):
         theta0 = np.clip(theta0, lo, hi)
+        fraction = share[0] + (share[1] - share[0]) * i / len(starts)
+        residuals = _reporting(problem.residuals, progress, fraction, f"start {i + 1} of {len(starts)}")
         try:
-            sol, _ = minimise(problem.residuals, theta0, lo, hi, FIT_NFEV, xtol=1e-12)
+            sol, _ = minimise(residuals, theta0, lo, hi, FIT_NFEV, xtol=1e-12)
         except (ValueError, FloatingPointError, OverflowError):
             continue  # a start the model cannot evaluate: try the next
         if np.all(np.isfinite(sol.fun)) and (best is None or sol.cost < best.cost):
@@ -267,17 +309,19 @@ def fitted_name(name: str | None) -> str | None:
     return f"{name} (fitted)"
 
 
-def _profiled(problem: _Problem, sol):
+def _profiled(problem: _Problem, sol, progress: Progress | None = None):
     """Profile every free parameter; if the walk finds a lower misfit than the optimum (the
     search was not global), refit from there and profile again. The solution, its intervals in
     natural units and whether the profile finished within its count of evaluations."""
     lo, hi = problem.bounds()
-    for _ in range(3):
+    for attempt in range(3):
         sd = _uncertainties(problem, sol)[2]
-        prof = profile(problem.residuals, sol.x, lo, hi, sd)
+        stage = "profiling the intervals" + (f" again ({attempt + 1})" if attempt else "")
+        budget = 2 * len(problem.free) * SIDE_EVALUATIONS  # profile's most
+        prof = profile(_reporting(problem.residuals, progress, 0.6 + 0.1 * attempt, stage, budget, 0.3), sol.x, lo, hi, sd)
         if prof.better is None:
             break
-        moved = _solve(problem, [prof.better])
+        moved = _solve(problem, [prof.better], progress, (0.65 + 0.1 * attempt,) * 2)
         if moved.cost >= sol.cost:
             break
         sol = moved
@@ -357,7 +401,8 @@ def _result(problem: _Problem, sol, method: str, starts: int, design: Design, in
 
 def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: MeasuredLoop | None = None,
                *, starts: int = 8, free: tuple[str, ...] = MATERIAL, seed: int = 0,
-               initial: Sequence[Mapping[str, float]] = (), intervals: bool = True) -> FitResult:
+               initial: Sequence[Mapping[str, float]] = (), intervals: bool = True,
+               progress: Progress | None = None) -> FitResult:
     """Fit the parameters ``free`` of ``design`` to all the data at once.
 
     ``design`` gives the geometry, the mode and the starting values; ``data`` measured
@@ -366,7 +411,9 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     values and ``starts − 1`` seeded points around them, or, if ``initial`` is given, from those
     points (mappings of some free parameters' values, the rest the design's). With
     ``intervals`` each parameter is profiled (:mod:`core.identify.uncertainty`) for its interval, which
-    may also find a better optimum than the starts did.
+    may also find a better optimum than the starts did. ``progress(fraction, message)``, if given,
+    hears where the fit is (the start of how many, the profile, the count of evaluations) a few
+    times a second at most; the result does not depend on it.
     Returns a :class:`FitResult`.
     """
     if data is None and loop is None:
@@ -380,14 +427,15 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     if n <= len(free):
         raise ValueError(f"{n // 2} points cannot determine {len(free)} parameters")
     problem = _Problem(design, data, loop, tuple(free))
+    progress = _forward(progress)
     if initial:
         points = [problem.to_theta({**problem.base, **dict(v)}) for v in initial]
     else:
         points = _starts(problem, starts, seed)
-    sol = _solve(problem, points)
+    sol = _solve(problem, points, progress, (0.0, 0.6 if intervals else 1.0))
     if not intervals:
         return _result(problem, sol, "global", len(points), design)
-    sol, found, complete = _profiled(problem, sol)
+    sol, found, complete = _profiled(problem, sol, progress)
     return _result(problem, sol, "global", len(points), design, found, _warnings(problem, sol, found, complete))
 
 
@@ -435,20 +483,27 @@ def predicted(result: FitResult, data: MeasuredStiffness, fitted_on: np.ndarray,
 
 
 def fit_two_step(design: Design, loop: MeasuredLoop, sweep: MeasuredStiffness,
-                 *, rounds: int = 2) -> FitResult:
+                 *, rounds: int = 2, progress: Progress | None = None) -> FitResult:
     """The thesis' identification (Paper B): the quasi-static loop gives µ, σ_fmax, ε½ (m and α
     held), the one-amplitude frequency sweep gives m and α (the others held), ``rounds`` times;
     then all five are refined together on the loop and the sweep (alternating steps alone creep
-    along the strong µ–m correlation), which is the point the alternation converges to."""
+    along the strong µ–m correlation), which is the point the alternation converges to.
+    ``progress(fraction, message)``, if given, hears the round and step ("round 1 of 2, the loop: …")."""
+    def step(fraction: float, words: str) -> Progress | None:
+        return None if progress is None else lambda f, m: progress(fraction + 0.1 * f, f"{words}: {m}")
+
     current = design
     history = []
     on_loop = BRANCH_PARAMETERS["elastic"] + BRANCH_PARAMETERS["friction"]  # µ, σ_fmax, ε½
-    for _ in range(rounds):
-        step1 = fit_global(current, loop=loop, free=on_loop, starts=4, intervals=False)
+    for i in range(rounds):
+        at = 0.6 * i / rounds
+        step1 = fit_global(current, loop=loop, free=on_loop, starts=4, intervals=False,
+                           progress=step(at, f"round {i + 1} of {rounds}, the loop"))
         step2 = fit_global(step1.design, data=sweep, free=BRANCH_PARAMETERS["fractional"],
-                           starts=4, intervals=False)
+                           starts=4, intervals=False, progress=step(at + 0.3 / rounds, f"round {i + 1} of {rounds}, the sweep"))
         current = step2.design
         history.append(as_dict(current.material))
-    joint = fit_global(current, data=sweep, loop=loop, starts=1)
+    joint = fit_global(current, data=sweep, loop=loop, starts=1,
+                       progress=None if progress is None else lambda f, m: progress(0.6 + 0.4 * f, f"all five together, {m}"))
     return dataclasses.replace(joint, method="two-step", starts=4,
                                history=[*history, as_dict(joint.design.material)])
