@@ -205,7 +205,9 @@ class MeasuredView(PlotView):
                          "are the fitted design's.")
         self.summary.object = "\n\n".join(lines)
         empty = s.measured is None and s.measured_loop is None
-        self.how_to.visible = empty
+        # its words go with the summary; hidden with the plots shown (a change of layout costs the
+        # page a third of a second of re-layout, which the summary does not wait for)
+        self.how_to.object = HOW_TO if empty else ""
         self.fit_button.disabled = empty or self.fit.running
         if self.plots_box is None:
             self._draw(points, residuals, groups, empty)
@@ -237,6 +239,7 @@ class MeasuredView(PlotView):
         if self.plots_box is None:
             self.plots_box = pn.Column(self.residuals.grid(2), sizing_mode="stretch_width")
         self.plots_box.visible = not empty
+        self.how_to.visible = empty
 
     @staticmethod
     def _results_table(r):
