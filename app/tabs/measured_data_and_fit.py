@@ -27,7 +27,7 @@ from ..shapes import shape_pane
 from ..state import ExplorerState, measured_amplitudes
 from ..uploads import csv_dropper, on_files, on_upload, verdict_html
 from ..views import PlotView
-from ..work import PageClosed, in_thread
+from ..work import PageClosed, in_thread, page_open
 
 RESIDUALS = (("magnitude", "frequency"), ("loss", "frequency"), ("magnitude", "amplitude"), ("loss", "amplitude"))
 DATA = ("magnitude", "loss")  # the data-over-model plots, drawn before the residuals
@@ -213,9 +213,10 @@ class MeasuredView(PlotView):
             self._draw(points, residuals, groups, empty)
         else:  # the text first (one message), the plots in the next: a first upload's new glyphs take the
             # browser seconds to build, and the verdict and summary do not wait for them
-            pn.state.execute(lambda: update_or_keep("MeasuredView kept its last plots",
-                                                    lambda: self._draw(points, residuals, groups, empty)),
-                             schedule=True)
+            doc = pn.state.curdoc  # a page closed meanwhile gets nothing more (app.work.page_open)
+            pn.state.execute(lambda: page_open(doc) and update_or_keep(
+                "MeasuredView kept its last plots", lambda: self._draw(points, residuals, groups, empty)),
+                schedule=True)
         options = {format_value(units.display_amplitude(a, mode), unit): a for a in measured_amplitudes(s.measured)}
         if options != self.sweep.options:
             self.sweep.options = options
