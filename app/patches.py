@@ -360,7 +360,7 @@ if (window.bushingUploadAtOnce == null) {
         event.stopImmediatePropagation()
         const files = Array.from(input.files)
         input.value = ""  // the same file can be chosen again, as FilePond allows
-        view._file_pond.addFiles(files)
+        view._file_pond.addFiles(files).catch(() => {})  // a refused file: FilePond's message in its area
       }, true)
     }
     document.addEventListener("FilePond:init", (event) => browsed(event.composedPath()[0]))
