@@ -244,6 +244,6 @@ def test_a_file_is_sent_as_soon_as_its_drop_area_has_it(page, explorer_url):
     page.get_by_text(re.compile(r"Stiffness: 150 points")).first.wait_for()
     page.wait_for_function("() => window.bushingUploads.processed >= 1")  # the drop area says it is sent
     seen = page.evaluate("() => window.bushingUploads")
-    assert page.evaluate("() => window.bushingUploadAtOnce") == "on"  # app.patches.UPLOAD_AT_ONCE found its internals
     assert seen["atSend"] == [["PROCESSING_QUEUED"]], seen["atSend"]
+    assert page.evaluate("() => window.bushingUploadAtOnce") == "on"  # app.patches.UPLOAD_AT_ONCE found its internals
     expect(page.locator(".filepond--item[data-filepond-item-state='processing-complete']")).to_have_count(1)
