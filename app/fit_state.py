@@ -15,7 +15,7 @@ import dataclasses
 import numpy as np
 import param
 
-from core.identify.fit import FitResult, fit_global, fit_two_step, predicted, selection
+from core.identify.fit import FitResult, Progress, fit_global, fit_two_step, predicted, selection
 from core.numbers import parse_number
 from core.parameters import MODE, MODE_TABLE
 from core.rules import RuleError
@@ -50,6 +50,11 @@ class FitState(param.Parameterized):
                           "comma-separated, e.g. mode=axial,amplitude=0.1: the fit uses those rows and "
                           "predicts the others, with the gap of each mode and amplitude.")
 
+    # a fit under way (app.work.in_thread): where it is, for the page's progress line
+    running = param.Boolean(default=False, doc="Whether a fit of this session is under way.")
+    progress = param.Number(default=0.0, bounds=(0.0, 1.0), doc="How far the running fit is (0–1).")
+    progress_message = param.String(default="", doc="Where the running fit is, in words (\"start 2 of 8\").")
+
     def __init__(self, state: ExplorerState, **params):
         super().__init__(state=state, **params)
 
@@ -62,9 +67,11 @@ class FitState(param.Parameterized):
         of the data (the same values)."""
         self.fit_result = None
 
-    def compute_fit(self) -> FitResult:
+    def compute_fit(self, progress: Progress | None = None) -> FitResult:
         """Fit the five material parameters to the measured data (the current design is the
-        first start). Pure: safe to run in a worker thread; :meth:`store_fit` stores it."""
+        first start), telling ``progress(fraction, message)`` where it is, if given
+        (:func:`core.identify.fit.fit_global`). Pure: safe to run in a worker thread;
+        :meth:`store_fit` stores it."""
         s = self.state
         if s.measured is None and s.measured_loop is None:
             raise ValueError("load measured stiffness (and optionally a loop) first")
@@ -76,18 +83,18 @@ class FitState(param.Parameterized):
             sweep = s.measured.select(s.measured.amplitude == amp)
             if len(sweep) < 3:
                 raise ValueError("the sweep at that amplitude has fewer than 3 points")
-            return fit_two_step(s.design, s.measured_loop, sweep)
+            return fit_two_step(s.design, s.measured_loop, sweep, progress=progress)
         if not self.fit_on.strip() or s.measured is None:
-            return fit_global(s.design, s.measured, s.measured_loop)
+            return fit_global(s.design, s.measured, s.measured_loop, progress=progress)
         spec = self.fit_on.strip()[:500]
         chosen = shown_selection(s.measured, s.design.mode, spec)
-        result = fit_global(s.design, s.measured.select(chosen), s.measured_loop)
+        result = fit_global(s.design, s.measured.select(chosen), s.measured_loop, progress=progress)
         return dataclasses.replace(result, prediction=predicted(result, s.measured, chosen, spec))
 
-    def try_fit(self) -> FitResult | str:
+    def try_fit(self, progress: Progress | None = None) -> FitResult | str:
         """:meth:`compute_fit`, or why it cannot run (pure: safe in a worker thread)."""
         try:
-            return self.compute_fit()
+            return self.compute_fit(progress)
         except ValueError as exc:
             return str(exc)
 

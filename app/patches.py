@@ -63,6 +63,14 @@ slider in the new mode's unit beside the operating point's text in the old one f
 frames, until the plots were computed (a browser test samples every frame). Held, everything
 a change sets arrives in one message and is painted at once.
 
+**A file is sent as soon as its drop area has it** (:data:`UPLOAD_AT_ONCE`; issue #27 item 16).
+FilePond starts processing (Panel's FileDropper sends from its ``server.process``) only once its
+animations rest: a CSV left the page 1.1 s after the drop area had it, of 1.9 s to its summary
+(``benchmarks/upload_speed.py``). The page sends it at FilePond's ``addfile`` (type and size
+checked) through the view's ``_process_upload``; FilePond's later ``process`` only completes the
+item. *Browse* hands the file to FilePond (``addFiles``) at once, not 250 ms later as its input
+does. A browser test checks that the bytes leave, once, while FilePond still holds the file queued.
+
 **Data-only updates** (:func:`holoviews_plots`, :func:`written`). HoloViews builds each plot
 (its dimensions, styles, legend, linked axes, tap stream); a later frame with the same elements
 (kinds, labels, styles, dimensions) differs only in its numbers, and those are written into the
@@ -106,7 +114,7 @@ def install(doc=None) -> None:
     """Put the hooks of this module in place, each once however often it is called: the MathJax
     decision and the number edits without debounce (process-wide), and the BokehJS paint patches
     in the page of ``doc`` (if given, unless ``BUSHING_BOKEHJS_PATCHES=0``), and
-    :data:`BOKEHJS_SERVER_MODELS` and :data:`LABEL_CLICKS` in it (if given)."""
+    :data:`BOKEHJS_SERVER_MODELS`, :data:`LABEL_CLICKS` and :data:`UPLOAD_AT_ONCE` in it (if given)."""
     global _installed
     if not _installed:
         if hasattr(panel_resources, "_panel_use_mathjax"):
@@ -123,6 +131,7 @@ def install(doc=None) -> None:
 
         doc.js_on_event("document_ready", CustomJS(code=BOKEHJS_SERVER_MODELS))
         doc.js_on_event("document_ready", CustomJS(code=LABEL_CLICKS))
+        doc.js_on_event("document_ready", CustomJS(code=UPLOAD_AT_ONCE))
         local_stylesheets(doc)
         _pages.add(doc)
 
@@ -297,6 +306,80 @@ if (!window.bushingLabelClicks) {
     const box = [...root.children].find(el => el.matches('input[type=checkbox], .bk-body'));
     if (box && !path.includes(box) && !box.disabled && !root.host.classList.contains('bk-disabled')) box.click();
   });
+}
+"""
+
+
+# window.bushingUploadAtOnce: "on" once installed, "unpatched" if Panel's FileDropper view has no
+# _process_upload (then FilePond sends the file itself, after its animations)
+UPLOAD_AT_ONCE = """
+if (window.bushingUploadAtOnce == null) {
+  const model = Bokeh.Models.get("panel.models.file_dropper.FileDropper")
+  const proto = model?.prototype?.default_view?.prototype
+  if (proto != null && typeof proto._process_upload === "function") {
+    const sent = new WeakSet()  // files already sent, whose FilePond process only completes them
+    const send = proto._process_upload
+    proto._process_upload = function (file, load, error, progress) {
+      if (!sent.has(file)) return send.call(this, file, load, error, progress)
+      sent.delete(file)
+      progress(true, file.size, file.size)
+      load(file.name)
+      return Promise.resolve({abort: () => {}})
+    }
+    const viewOf = (root) => {  // the FileDropper view whose FilePond has this root element
+      const seen = new Set()
+      const walk = (view) => {
+        if (seen.has(view)) return null
+        seen.add(view)
+        if (view._file_pond != null && view._file_pond.element === root) return view
+        if (typeof view.children === "function") for (const child of view.children()) {
+          const found = walk(child)
+          if (found != null) return found
+        }
+        return null
+      }
+      for (const root of Bokeh.index) {
+        const found = walk(root)
+        if (found != null) return found
+      }
+      return null
+    }
+    document.addEventListener("FilePond:addfile", (event) => {
+      const {file, error} = event.detail ?? {}
+      if (error != null || file == null || !(file.file instanceof Blob)) return
+      const view = viewOf(event.composedPath()[0])
+      if (view == null || sent.has(file.file)) return
+      sent.add(file.file)
+      const none = () => {}
+      send.call(view, file.file, none, none, none)
+    })
+    // a file chosen with Browse: FilePond's input hands it to FilePond 250 ms after the choice;
+    // handed at once here (FilePond's addFiles: its checks of type and size as for a drop)
+    const browsed = (root) => {
+      const input = root?.querySelector?.("input.filepond--browser")
+      const view = viewOf(root)
+      if (input == null || view == null || input.bushingAtOnce) return
+      input.bushingAtOnce = true
+      input.addEventListener("change", (event) => {
+        if (!input.files || input.files.length == 0) return
+        event.stopImmediatePropagation()
+        const files = Array.from(input.files)
+        input.value = ""  // the same file can be chosen again, as FilePond allows
+        view._file_pond.addFiles(files).catch(() => {})  // a refused file: FilePond's message in its area
+      }, true)
+    }
+    document.addEventListener("FilePond:init", (event) => browsed(event.composedPath()[0]))
+    for (const root of Bokeh.index) {  // the drop areas already there
+      const walk = (view) => {
+        if (view._file_pond != null) browsed(view._file_pond.element)
+        if (typeof view.children === "function") for (const child of view.children()) walk(child)
+      }
+      walk(root)
+    }
+    window.bushingUploadAtOnce = "on"
+  } else {
+    window.bushingUploadAtOnce = "unpatched"
+  }
 }
 """
 

@@ -150,3 +150,33 @@ def test_a_refitted_design_is_named_fitted_once():
     data = synthetic_stiffness(PAPER_B, np.linspace(1, 100, 10), [1e-5, 1e-4, 1e-3], seed=1)
     report = diagnose(PAPER_B, data, held_out=False).report()
     assert report["design"]["name"] == f"{PAPER_B.name} (fitted)"
+
+
+def test_progress_tells_where_the_fit_is_and_changes_nothing():
+    """``progress`` hears every start of how many, then the profile, its fractions never going
+    back and within 0–1; the result is the same fit as without it (issue #27 item 12)."""
+    design, freqs, amps = CASES["axial"]
+    data = synthetic(design, freqs, amps, seed=4)
+    heard = []
+    quiet = fit_global(design, data, starts=3)
+    told = fit_global(design, data, starts=3, progress=lambda f, m: heard.append((f, m)))
+    assert told.to_json() == quiet.to_json()
+    messages = [m for _, m in heard]
+    assert [m for m in messages if "," not in m][:3] == ["start 1 of 3", "start 2 of 3", "start 3 of 3"]
+    assert any(m.startswith("profiling the intervals") for m in messages)
+    fractions = [f for f, _ in heard]
+    assert all(0.0 <= f <= 1.0 for f in fractions) and fractions == sorted(fractions)
+
+
+def test_two_step_progress_names_its_rounds():
+    design, freqs, _ = CASES["axial"]
+    loop = synthetic_loop(design, 0.1, 1e-4, seed=5)
+    sweep = synthetic(design, freqs, [1e-4], seed=6)
+    heard = []
+    told = fit_two_step(design, loop, sweep, progress=lambda f, m: heard.append((f, m)))
+    assert told.to_json() == fit_two_step(design, loop, sweep).to_json()
+    messages = [m for _, m in heard]
+    for words in ("round 1 of 2, the loop: start 1 of 4", "round 2 of 2, the sweep: start 1 of 4",
+                  "all five together, start 1 of 1"):
+        assert words in messages, words
+    assert all(0.0 <= f <= 1.0 for f, _ in heard)

@@ -4,7 +4,6 @@ material parameters, take the fitted design into the explorer. Thin: the state (
 
 from __future__ import annotations
 
-import asyncio
 import io
 import logging
 
@@ -21,13 +20,14 @@ from .. import curves, units
 from ..curves import padded
 from ..fit_state import FIT_DEPENDS, FitState
 from ..inputs import tip
-from ..live import LivePlot, update_or_keep
+from ..live import LivePlot, one_change, update_or_keep
 from ..plotting.measured_data_and_fit import data_overlays, prediction_overlay, residual_overlays
 from ..plotting.style import ranged
 from ..shapes import shape_pane
 from ..state import ExplorerState, measured_amplitudes
 from ..uploads import csv_dropper, on_files, on_upload, verdict_html
 from ..views import PlotView
+from ..work import PageClosed, in_thread, page_open
 
 RESIDUALS = (("magnitude", "frequency"), ("loss", "frequency"), ("magnitude", "amplitude"), ("loss", "amplitude"))
 DATA = ("magnitude", "loss")  # the data-over-model plots, drawn before the residuals
@@ -73,6 +73,11 @@ class MeasuredView(PlotView):
                                             description=tip("A global fit from 8 starting points, the current design first.",
                                                             "top_right"))
         self.fit_button.on_click(self._fit)
+        # while a fit runs: where it is (issue #27 item 12), replaced by its result in one push
+        self.fit_progress = pn.indicators.Progress(value=0, max=100, visible=False, sizing_mode="stretch_width",
+                                                   height=12)
+        self.fit_progress_text = pn.pane.HTML("", sizing_mode="stretch_width")
+        fit.param.watch(self._on_fit_progress, ["running", "progress", "progress_message"])
         self.method = pn.widgets.RadioButtonGroup.from_param(fit.param.fit_method, description=fit.param.fit_method.doc)
         self.fit_on = pn.widgets.TextInput.from_param(fit.param.fit_on, description=fit.param.fit_on.doc,
                                                       placeholder="e.g. mode=axial,amplitude=0.1 (amplitudes in mm or rad)", max_length=500,
@@ -125,12 +130,41 @@ class MeasuredView(PlotView):
         self.state.load_measured_loop(loop.to_csv(), "paper_b_loop.csv")
 
     async def _fit(self, _event):
-        self.fit_button.loading = True
+        """The fit in a worker thread (the server stays responsive), where it is shown as it goes
+        (:func:`app.work.in_thread`); its result (or why there is none) replaces the progress in
+        one push. A page closed meanwhile gets nothing more; data changed meanwhile get no fit
+        of the old data."""
+        fit, s = self.fit, self.state
+        if fit.running:
+            return
+        data = (s.measured, s.measured_loop)
+        fit.param.update(running=True, progress=0.0, progress_message="starting")
         try:
-            # computed in a worker (the server stays responsive), stored here in the session
-            self.fit.store_fit(await asyncio.to_thread(self.fit.try_fit))
-        finally:
-            self.fit_button.loading = False
+            outcome = await in_thread(fit.try_fit, self._show_fit_progress, pn.state.curdoc)
+        except PageClosed:
+            return  # nothing is written to a closed page's document, not even "running" ended
+        except Exception as exc:  # noqa: BLE001 - never a traceback in the page; one line in the log
+            log.warning("fit failed: %s: %s", type(exc).__name__, exc)
+            outcome = f"The fit failed ({type(exc).__name__}): {exc}"
+        if any(a is not b for a, b in zip((s.measured, s.measured_loop), data)) and not isinstance(outcome, str):
+            outcome = "The data changed during the fit: press Fit again to fit the data loaded now"
+        with one_change():
+            fit.param.update(running=False, progress=1.0)
+            fit.store_fit(outcome)
+
+    def _show_fit_progress(self, fraction: float, message: str):
+        self.fit.param.update(progress=fraction, progress_message=message)
+
+    def _on_fit_progress(self, *_events):
+        """The progress line and the Fit button as the fit's state says: the button disabled
+        (and spinning) and the line shown while a fit runs."""
+        f = self.fit
+        self.fit_progress.visible = f.running
+        self.fit_progress.value = round(100 * f.progress)
+        self.fit_progress_text.object = (f'<i class="fit-progress">Fitting: {f.progress_message}…</i>'
+                                         if f.running else "")
+        self.fit_button.loading = f.running
+        self.fit_button.disabled = f.running or (self.state.measured is None and self.state.measured_loop is None)
 
     def _fitted_json(self):
         r = self.fit.fit_result
@@ -171,15 +205,18 @@ class MeasuredView(PlotView):
                          "are the fitted design's.")
         self.summary.object = "\n\n".join(lines)
         empty = s.measured is None and s.measured_loop is None
-        self.how_to.visible = empty
-        self.fit_button.disabled = empty
+        # its words go with the summary; hidden with the plots shown (a change of layout costs the
+        # page a third of a second of re-layout, which the summary does not wait for)
+        self.how_to.object = HOW_TO if empty else ""
+        self.fit_button.disabled = empty or self.fit.running
         if self.plots_box is None:
             self._draw(points, residuals, groups, empty)
         else:  # the text first (one message), the plots in the next: a first upload's new glyphs take the
             # browser seconds to build, and the verdict and summary do not wait for them
-            pn.state.execute(lambda: update_or_keep("MeasuredView kept its last plots",
-                                                    lambda: self._draw(points, residuals, groups, empty)),
-                             schedule=True)
+            doc = pn.state.curdoc  # a page closed meanwhile gets nothing more (app.work.page_open)
+            pn.state.execute(lambda: page_open(doc) and update_or_keep(
+                "MeasuredView kept its last plots", lambda: self._draw(points, residuals, groups, empty)),
+                schedule=True)
         options = {format_value(units.display_amplitude(a, mode), unit): a for a in measured_amplitudes(s.measured)}
         if options != self.sweep.options:
             self.sweep.options = options
@@ -203,6 +240,7 @@ class MeasuredView(PlotView):
         if self.plots_box is None:
             self.plots_box = pn.Column(self.residuals.grid(2), sizing_mode="stretch_width")
         self.plots_box.visible = not empty
+        self.how_to.visible = empty
 
     @staticmethod
     def _results_table(r):
@@ -256,6 +294,8 @@ class MeasuredView(PlotView):
             self.summary,
             pn.Row(self.method, self.sweep, self.fit_on),
             pn.Row(self.fit_button, self.use),
+            self.fit_progress,
+            self.fit_progress_text,
             self.download,
             self.results,
             self.prediction_box,

@@ -35,14 +35,17 @@ from ..bushing import PointsModel, check_measured_amplitude, stiffness_points
 from ..data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from ..design import Design
 from ..loops import loop_force
-from ..numbers import format_number
-from ..parameters import BRANCH_PARAMETERS, MATERIAL, Parameter
+from ..parameters import BRANCH_PARAMETERS, MATERIAL
 from ..parts import as_dict
-from ..registry import parameter, parameter_unit, parameter_values, with_values
+from ..registry import parameter, parameter_values, with_values
 from ..residuals import gap, gaps_by_mode, relative_residual
 from ..rules import decimal
 from ..sampling import latin_hypercube
 from ..shape import OutsideTable
+from .fit_words import fit_warnings as _warnings
+from .progress import PROGRESS_EVERY, Progress  # noqa: F401
+from .progress import forward as _forward
+from .progress import reporting as _reporting
 from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS, Paths, linearised, minimise, profile
 
 FIT_NFEV = (100, 100, 200)  # iterations from one start in the stages of uncertainty.minimise
@@ -278,15 +281,20 @@ def _starts(problem: _Problem, n: int, seed: int = 0) -> list[np.ndarray]:
     return starts
 
 
-def _solve(problem: _Problem, starts: list[np.ndarray]):
+def _solve(problem: _Problem, starts: list[np.ndarray], progress: Progress | None = None,
+           share: tuple[float, float] = (0.0, 0.6)):
+    """The best of the bounded least-squares searches from ``starts``; ``progress`` told which
+    start of how many runs, its fraction within ``share``."""
     lo, hi = problem.bounds()
     best = None
     paths = Paths(lo, hi)
-    for theta0 in starts:
+    for i, theta0 in enumerate(starts):
         theta0 = np.clip(theta0, lo, hi)
+        fraction = share[0] + (share[1] - share[0]) * i / len(starts)
+        residuals = _reporting(problem.residuals, progress, fraction, f"start {i + 1} of {len(starts)}")
         walked: list = []
         try:
-            sol, _ = minimise(problem.residuals, theta0, lo, hi, FIT_NFEV, xtol=1e-12, many=problem.residuals_many,
+            sol, _ = minimise(residuals, theta0, lo, hi, FIT_NFEV, xtol=1e-12, many=problem.residuals_many,
                               callback=paths.follow(walked))
         except (ValueError, FloatingPointError, OverflowError):
             continue  # a start the model cannot evaluate: try the next
@@ -309,17 +317,20 @@ def fitted_name(name: str | None) -> str | None:
     return f"{name} (fitted)"
 
 
-def _profiled(problem: _Problem, sol):
+def _profiled(problem: _Problem, sol, progress: Progress | None = None):
     """Profile every free parameter; if the walk finds a lower misfit than the optimum (the
     search was not global), refit from there and profile again. The solution, its intervals in
     natural units and whether the profile finished within its count of evaluations."""
     lo, hi = problem.bounds()
-    for _ in range(3):
+    for attempt in range(3):
         sd = _uncertainties(problem, sol)[2]
-        prof = profile(problem.residuals, sol.x, lo, hi, sd, many=problem.residuals_many)
+        stage = "profiling the intervals" + (f" again ({attempt + 1})" if attempt else "")
+        budget = 2 * len(problem.free) * SIDE_EVALUATIONS  # profile's most
+        prof = profile(_reporting(problem.residuals, progress, 0.6 + 0.1 * attempt, stage, budget, 0.3), sol.x, lo, hi,
+                       sd, many=problem.residuals_many)
         if prof.better is None:
             break
-        moved = _solve(problem, [prof.better])
+        moved = _solve(problem, [prof.better], progress, (0.65 + 0.1 * attempt,) * 2)
         if moved.cost >= sol.cost:
             break
         sol = moved
@@ -328,52 +339,6 @@ def _profiled(problem: _Problem, sol):
         ends = [None if t is None else math.exp(t) if spec.log else float(t) for t in (a, b)]
         intervals[name] = (ends[0], ends[1])
     return sol, intervals, prof.complete
-
-
-def _unit_words(name: str, mode: str) -> str:
-    """" kg" after a value of ``name`` in ``mode``; nothing after a pure number."""
-    unit = parameter_unit(name, mode)
-    return "" if unit == "–" else f" {unit}"
-
-
-def _pushed(spec: Parameter, x: float, interval, edge: str, span: float) -> bool:
-    """Whether the data push a parameter at the ``edge`` of its fitting range against it: its
-    profile excludes values a tenth of the range away (else the data do not see it there, as a
-    mass of 1e-12 kg, and it is merely not determined)."""
-    if interval is None:
-        return True  # not profiled: the edge is all that is known
-    inner = interval[1] if edge == "lower" else interval[0]  # the side away from the edge
-    if inner is None:
-        return False
-    return abs((math.log(inner) if spec.log else inner) - x) <= span / 10
-
-
-def _warnings(problem: _Problem, sol, intervals: dict, complete: bool) -> tuple[str, ...]:
-    """Plain words for what the user must know about a fit: parameters driven to the end of
-    their fitting range, parameters the data do not determine, an unfinished profile."""
-    lo, hi = problem.bounds()
-    values = problem.values(sol.x)
-    out, at_edge = [], set()
-    for i, (name, spec) in enumerate(zip(problem.free, problem.specs)):
-        span = hi[i] - lo[i]
-        edge = "lower" if sol.x[i] - lo[i] <= 1e-6 * span else "upper" if hi[i] - sol.x[i] <= 1e-6 * span else None
-        if edge and _pushed(spec, sol.x[i], intervals.get(name), edge, span):
-            at_edge.add(name)
-            unit = _unit_words(name, problem.design.mode)
-            out.append(f"{name} ran to the {edge} end of its fitting range ({format_number(values[name], 3)}{unit}): "
-                       f"the model cannot follow these data there; check that the design's mode and "
-                       f"geometry are those of the measurement")
-    for name, (a, b) in intervals.items():
-        if (a is None or b is None) and name not in at_edge:
-            unit = _unit_words(name, problem.design.mode)
-            which = ("any value in its fitting range" if a is None and b is None
-                     else f"any value up to {format_number(b, 3)}{unit}" if a is None else f"any value from {format_number(a, 3)}{unit} up")
-            out.append(f"{name} is not determined by these data: {which} fits them as well "
-                       f"({CONFIDENCE:.0%} profile); measure more amplitudes or frequencies to pin it down")
-    if not complete:
-        out.append(f"the profile intervals are incomplete: a side spent its {SIDE_EVALUATIONS} evaluations "
-                   f"of the model before the end (unfinished sides are open)")
-    return tuple(out)
 
 
 def _result(problem: _Problem, sol, method: str, starts: int, design: Design, intervals=None,
@@ -399,7 +364,8 @@ def _result(problem: _Problem, sol, method: str, starts: int, design: Design, in
 
 def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: MeasuredLoop | None = None,
                *, starts: int = 8, free: tuple[str, ...] = MATERIAL, seed: int = 0,
-               initial: Sequence[Mapping[str, float]] = (), intervals: bool = True) -> FitResult:
+               initial: Sequence[Mapping[str, float]] = (), intervals: bool = True,
+               progress: Progress | None = None) -> FitResult:
     """Fit the parameters ``free`` of ``design`` to all the data at once.
 
     ``design`` gives the geometry, the mode and the starting values; ``data`` measured
@@ -408,7 +374,9 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     values and ``starts − 1`` seeded points around them, or, if ``initial`` is given, from those
     points (mappings of some free parameters' values, the rest the design's). With
     ``intervals`` each parameter is profiled (:mod:`core.identify.uncertainty`) for its interval, which
-    may also find a better optimum than the starts did.
+    may also find a better optimum than the starts did. ``progress(fraction, message)``, if given,
+    hears where the fit is (the start of how many, the profile, the count of evaluations) a few
+    times a second at most; the result does not depend on it.
     Returns a :class:`FitResult`.
     """
     if data is None and loop is None:
@@ -422,14 +390,15 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     if n <= len(free):
         raise ValueError(f"{n // 2} points cannot determine {len(free)} parameters")
     problem = _Problem(design, data, loop, tuple(free))
+    progress = _forward(progress)
     if initial:
         points = [problem.to_theta({**problem.base, **dict(v)}) for v in initial]
     else:
         points = _starts(problem, starts, seed)
-    sol = _solve(problem, points)
+    sol = _solve(problem, points, progress, (0.0, 0.6 if intervals else 1.0))
     if not intervals:
         return _result(problem, sol, "global", len(points), design)
-    sol, found, complete = _profiled(problem, sol)
+    sol, found, complete = _profiled(problem, sol, progress)
     return _result(problem, sol, "global", len(points), design, found, _warnings(problem, sol, found, complete))
 
 
@@ -477,20 +446,27 @@ def predicted(result: FitResult, data: MeasuredStiffness, fitted_on: np.ndarray,
 
 
 def fit_two_step(design: Design, loop: MeasuredLoop, sweep: MeasuredStiffness,
-                 *, rounds: int = 2) -> FitResult:
+                 *, rounds: int = 2, progress: Progress | None = None) -> FitResult:
     """The thesis' identification (Paper B): the quasi-static loop gives µ, σ_fmax, ε½ (m and α
     held), the one-amplitude frequency sweep gives m and α (the others held), ``rounds`` times;
     then all five are refined together on the loop and the sweep (alternating steps alone creep
-    along the strong µ–m correlation), which is the point the alternation converges to."""
+    along the strong µ–m correlation), which is the point the alternation converges to.
+    ``progress(fraction, message)``, if given, hears the round and step ("round 1 of 2, the loop: …")."""
+    def step(fraction: float, words: str) -> Progress | None:
+        return None if progress is None else lambda f, m: progress(fraction + 0.1 * f, f"{words}: {m}")
+
     current = design
     history = []
     on_loop = BRANCH_PARAMETERS["elastic"] + BRANCH_PARAMETERS["friction"]  # µ, σ_fmax, ε½
-    for _ in range(rounds):
-        step1 = fit_global(current, loop=loop, free=on_loop, starts=4, intervals=False)
+    for i in range(rounds):
+        at = 0.6 * i / rounds
+        step1 = fit_global(current, loop=loop, free=on_loop, starts=4, intervals=False,
+                           progress=step(at, f"round {i + 1} of {rounds}, the loop"))
         step2 = fit_global(step1.design, data=sweep, free=BRANCH_PARAMETERS["fractional"],
-                           starts=4, intervals=False)
+                           starts=4, intervals=False, progress=step(at + 0.3 / rounds, f"round {i + 1} of {rounds}, the sweep"))
         current = step2.design
         history.append(as_dict(current.material))
-    joint = fit_global(current, data=sweep, loop=loop, starts=1)
+    joint = fit_global(current, data=sweep, loop=loop, starts=1,
+                       progress=None if progress is None else lambda f, m: progress(0.6 + 0.4 * f, f"all five together, {m}"))
     return dataclasses.replace(joint, method="two-step", starts=4,
                                history=[*history, as_dict(joint.design.material)])

@@ -1,7 +1,7 @@
-"""Issue #27 items 1, 8 and 14 in the browser: a measured file in the wrong units is refused at
+"""Issue #27 items 1, 8, 14 and 16 in the browser: a measured file in the wrong units is refused at
 upload with one message every tab shares; the data are drawn one colour per amplitude over the
 model at those amplitudes; the residuals follow the fit; without data the tab says what to load
-and Fit waits for data. The bad files are the example files with one column scaled."""
+and Fit waits for data; a file is sent as soon as its drop area has it. The bad files are the example files with one column scaled."""
 
 import json
 import re
@@ -214,3 +214,36 @@ def test_a_warned_file_is_a_warning_in_every_tab_and_goes_with_its_data(page, ex
     expect(page.locator(".diagnosis-note")).to_contain_text(said.removeprefix("Note:").strip())
     expect(page.locator(".diagnosis-error")).to_have_count(0)
     expect(page.get_by_role("button", name="Diagnose")).to_be_enabled()
+
+
+# in the page from now on: each file a drop area takes (FilePond's item, captured before any other
+# listener), the FilePond status of each at every upload message the page sends, and how many
+# files FilePond has finished processing (its "Sent" state)
+UPLOADS_JS = """() => {
+  const seen = window.bushingUploads = {files: [], atSend: [], processed: 0};
+  const names = Object.fromEntries(Object.entries(window.FilePond.FileStatus).map(([k, v]) => [v, k]));
+  window.addEventListener('FilePond:addfile', (e) => { if (e.detail.file) seen.files.push(e.detail.file); }, true);
+  window.addEventListener('FilePond:processfile', () => { seen.processed += 1; }, true);
+  const send = WebSocket.prototype.send;
+  WebSocket.prototype.send = function (data) {
+    if (typeof data === 'string' && data.includes('upload_event')) seen.atSend.push(seen.files.map(f => names[f.status]));
+    return send.call(this, data);
+  };
+}"""
+
+
+def test_a_file_is_sent_as_soon_as_its_drop_area_has_it(page, explorer_url):
+    """A stiffness CSV leaves the page the moment the drop area has accepted it, while the drop
+    area still holds it queued behind its animations (FilePond's PROCESSING_QUEUED), and once:
+    the summary does not wait for the drop area's animations (issue #27 item 16: 1.5 s from the
+    file to its summary, of which the file waited about a second in the page before it was sent,
+    by FilePond's processing, PROCESSING)."""
+    open_tab(page, explorer_url)
+    page.evaluate(UPLOADS_JS)
+    page.locator("#main input[type=file]").first.set_input_files(str(EXAMPLES / "paper_b_stiffness.csv"))
+    page.get_by_text(re.compile(r"Stiffness: 150 points")).first.wait_for()
+    page.wait_for_function("() => window.bushingUploads.processed >= 1")  # the drop area says it is sent
+    seen = page.evaluate("() => window.bushingUploads")
+    assert seen["atSend"] == [["PROCESSING_QUEUED"]], seen["atSend"]
+    assert page.evaluate("() => window.bushingUploadAtOnce") == "on"  # app.patches.UPLOAD_AT_ONCE found its internals
+    expect(page.locator(".filepond--item[data-filepond-item-state='processing-complete']")).to_have_count(1)

@@ -192,3 +192,99 @@ def test_a_buttons_description_covers_no_other_button(page, explorer_url, tab, b
     covered = [(b.inner_text() or b.evaluate("e => e.outerHTML.slice(0, 160)")) for b in page.get_by_role("button").all()
                if b.is_visible() and (other := b.bounding_box()) and other != own and overlap(box, other)]
     assert covered == [], covered
+
+
+FIT = "Fit the five material parameters"
+HELD_AT = "start 3 of 8"  # the global fit's third start (fit_global: 8 starts)
+
+
+class Gate:
+    """A fit held until the test lets it go: at the progress message ``at``, or as it starts
+    (``at`` None); ``ended`` set when the tab's handler of the Fit button has returned."""
+
+    def __init__(self):
+        self.at: str | None = HELD_AT
+        self.reached, self.release, self.ended = threading.Event(), threading.Event(), threading.Event()
+
+    def hold(self):
+        self.reached.set()
+        self.release.wait(60)
+
+
+@pytest.fixture
+def gated_fit(monkeypatch):
+    """The measured-data fit held (:class:`Gate`), its progress passed on."""
+    from app.fit_state import FitState
+    from app.tabs.measured_data_and_fit import MeasuredView
+
+    gate = Gate()
+    compute, handler = FitState.compute_fit, MeasuredView._fit
+
+    def gated(self, progress=None):
+        def say(fraction, message):
+            if progress is not None:
+                progress(fraction, message)
+            if message == gate.at:
+                gate.hold()
+
+        if gate.at is None:
+            gate.hold()
+        return compute(self, say)
+
+    async def watched(self, event):
+        try:
+            await handler(self, event)
+        finally:
+            gate.ended.set()
+
+    monkeypatch.setattr(FitState, "compute_fit", gated)
+    monkeypatch.setattr(MeasuredView, "_fit", watched)
+    return gate
+
+
+def load_example_data(page):
+    page.get_by_text("Measured data and fit", exact=True).click()
+    page.get_by_role("button", name="Load the synthetic Paper B example").click()
+    page.get_by_text(re.compile(r"Stiffness: \d+ points")).first.wait_for()
+    expect(page.get_by_role("button", name=FIT)).to_be_enabled()
+
+
+def test_the_fit_shows_where_it_is_until_its_result(page, explorer_url, gated_fit):
+    """While the fit of the measured data runs, the page says which start of how many it has
+    reached, with the Fit button disabled; the fitted parameters replace that line in one push
+    (once: a spinning button only, whatever the wait)."""
+    reached, release = gated_fit.reached, gated_fit.release
+    open_explorer(page, explorer_url)
+    load_example_data(page)
+    watch(page, r"Fitting: [^…]*…", r"Correlation between parameters")
+    page.get_by_role("button", name=FIT).click()
+    try:
+        expect(page.get_by_text(f"Fitting: {HELD_AT}…")).to_be_visible(timeout=60_000)
+        assert reached.is_set()  # shown while the fit was held there
+        expect(page.get_by_role("button", name=FIT)).to_be_disabled()
+    finally:
+        release.set()
+    seen = wait_report(page)
+    assert f"Fitting: {HELD_AT}…" in seen["progress"]
+    assert not seen["progressWithReport"]
+    expect(page.get_by_text(re.compile("Fitting: "))).to_have_count(0)
+    expect(page.get_by_role("button", name=FIT)).to_be_enabled()
+
+
+def test_a_page_closed_during_the_fit_leaves_no_traceback(page, context, explorer_url, gated_fit, server_log):
+    """A page closed while its fit runs: the fit ends and nothing is written to the gone page
+    (no WebSocketClosedError, no traceback in the server's log)."""
+    gated_fit.at = None  # held as it starts
+    reached, release, ended = gated_fit.reached, gated_fit.release, gated_fit.ended
+    other = context.new_page()
+    open_explorer(other, explorer_url)
+    load_example_data(other)
+    other.get_by_role("button", name=FIT).click()
+    try:
+        assert reached.wait(60)
+        other.close()
+    finally:
+        release.set()
+    assert ended.wait(120)
+    assert server_log.tracebacks() == []
+    assert not [r for r in server_log.records if "WebSocketClosed" in r.getMessage()]

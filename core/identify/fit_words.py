@@ -1,0 +1,59 @@
+"""Plain words for what the user must know about a fit (:func:`core.identify.fit.fit_global`):
+parameters driven to the end of their fitting range, parameters the data do not determine, an
+unfinished profile.
+"""
+
+from __future__ import annotations
+
+import math
+
+from ..numbers import format_number
+from ..parameters import Parameter
+from ..registry import parameter_unit
+from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS
+
+
+def _unit_words(name: str, mode: str) -> str:
+    """" kg" after a value of ``name`` in ``mode``; nothing after a pure number."""
+    unit = parameter_unit(name, mode)
+    return "" if unit == "–" else f" {unit}"
+
+
+def _pushed(spec: Parameter, x: float, interval, edge: str, span: float) -> bool:
+    """Whether the data push a parameter at the ``edge`` of its fitting range against it: its
+    profile excludes values a tenth of the range away (else the data do not see it there, as a
+    mass of 1e-12 kg, and it is merely not determined)."""
+    if interval is None:
+        return True  # not profiled: the edge is all that is known
+    inner = interval[1] if edge == "lower" else interval[0]  # the side away from the edge
+    if inner is None:
+        return False
+    return abs((math.log(inner) if spec.log else inner) - x) <= span / 10
+
+
+def fit_warnings(problem, sol, intervals: dict, complete: bool) -> tuple[str, ...]:
+    """Plain words for what the user must know about a fit: parameters driven to the end of
+    their fitting range, parameters the data do not determine, an unfinished profile."""
+    lo, hi = problem.bounds()
+    values = problem.values(sol.x)
+    out, at_edge = [], set()
+    for i, (name, spec) in enumerate(zip(problem.free, problem.specs)):
+        span = hi[i] - lo[i]
+        edge = "lower" if sol.x[i] - lo[i] <= 1e-6 * span else "upper" if hi[i] - sol.x[i] <= 1e-6 * span else None
+        if edge and _pushed(spec, sol.x[i], intervals.get(name), edge, span):
+            at_edge.add(name)
+            unit = _unit_words(name, problem.design.mode)
+            out.append(f"{name} ran to the {edge} end of its fitting range ({format_number(values[name], 3)}{unit}): "
+                       f"the model cannot follow these data there; check that the design's mode and "
+                       f"geometry are those of the measurement")
+    for name, (a, b) in intervals.items():
+        if (a is None or b is None) and name not in at_edge:
+            unit = _unit_words(name, problem.design.mode)
+            which = ("any value in its fitting range" if a is None and b is None
+                     else f"any value up to {format_number(b, 3)}{unit}" if a is None else f"any value from {format_number(a, 3)}{unit} up")
+            out.append(f"{name} is not determined by these data: {which} fits them as well "
+                       f"({CONFIDENCE:.0%} profile); measure more amplitudes or frequencies to pin it down")
+    if not complete:
+        out.append(f"the profile intervals are incomplete: a side spent its {SIDE_EVALUATIONS} evaluations "
+                   f"of the model before the end (unfinished sides are open)")
+    return tuple(out)
