@@ -368,30 +368,6 @@ def explorer_data(design: Design, frequency_hz: float, amplitude: float, *, freq
                         reference_loop=ref_loop, measured_loop=loop_points, ranges=ranges, bands=bands)
 
 
-# ---- a diagnosis (core.identify.diagnose.Diagnosis) ---------------------------------------------------------
-
-
-def gap_stages(r) -> dict:
-    """The gap after each stage of a diagnosis: the baseline, then each added effect; and the
-    gap the noise alone gives (None if it could not be estimated)."""
-    labels = ["baseline"] + [f"+ {s.effect}" for s in r.steps]
-    gaps = [r.baseline.gap] + [s.gap_after for s in r.steps]
-    return {"stage": labels, "gap": np.array(gaps), "noise": r.noise_gap}
-
-
-def misfit_points(r, which: str) -> dict:
-    """Model − data of a diagnosis' ``which`` model ("baseline" or "final") at every measured
-    point: |K| in % and the loss factor, the amplitude in display units."""
-    k = (r.baseline if which == "baseline" else r.final).stiffness
-    d = r.data
-    return {
-        "frequency_hz": d.frequency_hz,
-        "amplitude": units.display_amplitude(d.amplitude, r.final.design.mode),
-        "magnitude_pct": magnitude_residual_pct(k, d.stiffness),
-        "loss_factor": loss_factor(k) - d.loss_factor,
-    }
-
-
 def amplitude_groups(data: MeasuredStiffness, mode: str, models: dict, most: int = 5) -> list[dict]:
     """Measured stiffness (SI, one mode) and models at its points against frequency, one group per
     measured amplitude (the ``most`` most populated), in display units: each group's
@@ -406,13 +382,6 @@ def amplitude_groups(data: MeasuredStiffness, mode: str, models: dict, most: int
             group[name] = (units.display_stiffness(np.abs(k[sel]), mode), loss_factor(k[sel]))
         groups.append(group)
     return groups
-
-
-def curve_groups(r, most: int = 5) -> list[dict]:
-    """Data and both models of a diagnosis against frequency, one group per measured amplitude
-    (the ``most`` most populated), in display units (:func:`amplitude_groups`)."""
-    return amplitude_groups(r.data, r.final.design.mode,
-                            {"baseline": r.baseline.stiffness, "final": r.final.stiffness}, most)
 
 
 def measured_groups(measured: MeasuredStiffness | None, start: Design, fitted: Design | None = None) -> list[dict]:

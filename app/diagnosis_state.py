@@ -13,7 +13,7 @@ from core.identify.fit import fitted_name
 from core.io.table import csv_text
 from core.synthetic import MYSTERIES, Mystery
 
-from . import curves
+from . import report_curves
 from .state import ExplorerState, read_stiffness
 
 
@@ -132,16 +132,16 @@ class DiagnosisState(param.Parameterized):
 
     def gap_stages(self) -> dict:
         """The gap after each stage: baseline, then each added effect."""
-        return curves.gap_stages(self.result)
+        return report_curves.gap_stages(self.result)
 
     def misfit(self, which: str) -> dict:
         """Model − data over the (frequency, amplitude) plane: |K| in %, loss factor."""
-        return curves.misfit_points(self.shown(), which)
+        return report_curves.misfit_points(self.shown(), which)
 
     def curves(self) -> dict:
         """Data and both models against frequency, one group per measured amplitude (the most
         populated five), display units."""
-        return {"groups": curves.curve_groups(self.shown())}
+        return {"groups": report_curves.curve_groups(self.shown())}
 
     # ---- downloads -----------------------------------------------------------------------------
 

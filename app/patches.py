@@ -95,6 +95,7 @@ import contextlib
 import os
 import re
 import weakref
+from pathlib import Path
 
 import numpy as np
 from panel.io import resources as panel_resources
@@ -205,183 +206,30 @@ def frozen_models(doc):
             models.recompute()
 
 
-BOKEHJS_PAINT_PATCHES = """
-// window[flag] says what happened: `done` if the method was found and wrapped, else "unpatched".
-const patch = (flag, done, module, cls, method, wrap) => {
-  if (window[flag] != null) return
-  const mod = Bokeh.require(module)
-  const proto = mod != null && mod[cls] != null ? mod[cls].prototype : null
-  if (proto != null && typeof proto[method] === "function") {
-    proto[method] = wrap(proto[method])
-    window[flag] = done
-  } else {
-    window[flag] = "unpatched"
-  }
-}
-patch("bushingStyleWrites", "skip-unchanged", "core/dom", "InlineStyleSheet", "_update", (update) =>
-  function (css) { if (this.el.textContent !== css) update.call(this, css) })
-patch("bushingCssReads", "cached-per-task", "core/visuals/visual", "VisualProperties", "_get_css_value", (read) =>
-  function (name) {
-    if (this._bushing_css == null) {
-      this._bushing_css = new Map()
-      queueMicrotask(() => { this._bushing_css = null })
-    }
-    let value = this._bushing_css.get(name)
-    if (value === undefined) {
-      value = read.call(this, name)
-      this._bushing_css.set(name, value)
-    }
-    return value
-  })
-patch("bushingGlyphPosition", "inline-style", "models/renderers/glyph_renderer", "GlyphRendererView", "update_position", (update) =>
-  function () {
-    if (this.panel != null || this.position == null) {
-      return update.call(this)
-    }
-    if (this._bushing_inline == null) {
-      this.position.replace("")  // once: what an earlier paint wrote there no longer applies
-      this._bushing_inline = true
-    }
-    const { bbox } = this
-    const style = this.el.style
-    if (bbox != null && bbox.is_valid) {
-      style.removeProperty("display")
-      style.position = "absolute"
-      style.left = `${bbox.left}px`
-      style.top = `${bbox.top}px`
-      style.width = `${bbox.width}px`
-      style.height = `${bbox.height}px`
-    } else {
-      style.display = "none"
-    }
-  })
-"""
+JS = Path(__file__).with_name("js")  # the scripts the pages run, each in its own file
 
 
-BOKEHJS_SERVER_MODELS = """
-// window.bushingServerModels: "known" once patched, "unpatched" if BokehJS has no such internals
-if (window.bushingServerModels == null) {
-  const mod = Bokeh.require("document")
-  const proto = mod != null && mod.Document != null ? mod.Document.prototype : null
-  const doc = Bokeh.documents[0]
-  if (proto != null && typeof proto.apply_json_patch === "function" && doc != null && doc._new_models instanceof Set) {
-    // the ids of the models a patch defines ({type: "object", id, ...} anywhere in its events)
-    const defined = (value, ids) => {
-      if (Array.isArray(value)) {
-        for (const v of value) if (v !== null && typeof v === "object") defined(v, ids)
-      } else if (value !== null && typeof value === "object" && !ArrayBuffer.isView(value)
-                 && !(value instanceof ArrayBuffer)) {
-        if (value.type === "object" && typeof value.id === "string") ids.add(value.id)
-        for (const v of Object.values(value)) if (v !== null && typeof v === "object") defined(v, ids)
-      }
-      return ids
-    }
-    const apply = proto.apply_json_patch
-    proto.apply_json_patch = function (patch, buffers) {
-      apply.call(this, patch, buffers)
-      if (this._new_models.size == 0) return  // nothing the page counts as new: nothing to look for
-      const ids = defined(patch.events, new Set())
-      for (const model of [...this._new_models]) if (ids.has(model.id)) this._new_models.delete(model)
-    }
-    window.bushingServerModels = "known"
-  } else {
-    window.bushingServerModels = "unpatched"
-  }
-}
-"""
+def _script(name: str) -> str:
+    """The text of the page script ``app/js/<name>``."""
+    return (JS / name).read_text(encoding="utf-8")
+
+
+BOKEHJS_PAINT_PATCHES = _script("paint_patches.js")
+
+
+BOKEHJS_SERVER_MODELS = _script("server_models.js")
 
 
 # A checkbox's or a switch's label toggles it (issue #27): BokehJS 3.9 draws the label as a <div>
 # beside the box (a Checkbox's <input>, a Switch's .bk-body) in the widget's shadow root, not as a
 # <label>, so a click on the words did nothing. One listener on the page: a click whose path (through
 # open shadow roots) holds such a label and not the box itself clicks the box of the same root.
-LABEL_CLICKS = """
-if (!window.bushingLabelClicks) {
-  window.bushingLabelClicks = true;
-  document.addEventListener('click', (event) => {
-    const path = event.composedPath();
-    const label = path.find(el => el instanceof Element && el.classList.contains('bk-label'));
-    if (!label || !(label.parentNode instanceof ShadowRoot)) return;
-    const root = label.parentNode;
-    const box = [...root.children].find(el => el.matches('input[type=checkbox], .bk-body'));
-    if (box && !path.includes(box) && !box.disabled && !root.host.classList.contains('bk-disabled')) box.click();
-  });
-}
-"""
+LABEL_CLICKS = _script("label_clicks.js")
 
 
 # window.bushingUploadAtOnce: "on" once installed, "unpatched" if Panel's FileDropper view has no
 # _process_upload (then FilePond sends the file itself, after its animations)
-UPLOAD_AT_ONCE = """
-if (window.bushingUploadAtOnce == null) {
-  const model = Bokeh.Models.get("panel.models.file_dropper.FileDropper")
-  const proto = model?.prototype?.default_view?.prototype
-  if (proto != null && typeof proto._process_upload === "function") {
-    const sent = new WeakSet()  // files already sent, whose FilePond process only completes them
-    const send = proto._process_upload
-    proto._process_upload = function (file, load, error, progress) {
-      if (!sent.has(file)) return send.call(this, file, load, error, progress)
-      sent.delete(file)
-      progress(true, file.size, file.size)
-      load(file.name)
-      return Promise.resolve({abort: () => {}})
-    }
-    const viewOf = (root) => {  // the FileDropper view whose FilePond has this root element
-      const seen = new Set()
-      const walk = (view) => {
-        if (seen.has(view)) return null
-        seen.add(view)
-        if (view._file_pond != null && view._file_pond.element === root) return view
-        if (typeof view.children === "function") for (const child of view.children()) {
-          const found = walk(child)
-          if (found != null) return found
-        }
-        return null
-      }
-      for (const root of Bokeh.index) {
-        const found = walk(root)
-        if (found != null) return found
-      }
-      return null
-    }
-    document.addEventListener("FilePond:addfile", (event) => {
-      const {file, error} = event.detail ?? {}
-      if (error != null || file == null || !(file.file instanceof Blob)) return
-      const view = viewOf(event.composedPath()[0])
-      if (view == null || sent.has(file.file)) return
-      sent.add(file.file)
-      const none = () => {}
-      send.call(view, file.file, none, none, none)
-    })
-    // a file chosen with Browse: FilePond's input hands it to FilePond 250 ms after the choice;
-    // handed at once here (FilePond's addFiles: its checks of type and size as for a drop)
-    const browsed = (root) => {
-      const input = root?.querySelector?.("input.filepond--browser")
-      const view = viewOf(root)
-      if (input == null || view == null || input.bushingAtOnce) return
-      input.bushingAtOnce = true
-      input.addEventListener("change", (event) => {
-        if (!input.files || input.files.length == 0) return
-        event.stopImmediatePropagation()
-        const files = Array.from(input.files)
-        input.value = ""  // the same file can be chosen again, as FilePond allows
-        view._file_pond.addFiles(files).catch(() => {})  // a refused file: FilePond's message in its area
-      }, true)
-    }
-    document.addEventListener("FilePond:init", (event) => browsed(event.composedPath()[0]))
-    for (const root of Bokeh.index) {  // the drop areas already there
-      const walk = (view) => {
-        if (view._file_pond != null) browsed(view._file_pond.element)
-        if (typeof view.children === "function") for (const child of view.children()) walk(child)
-      }
-      walk(root)
-    }
-    window.bushingUploadAtOnce = "on"
-  } else {
-    window.bushingUploadAtOnce = "unpatched"
-  }
-}
-"""
+UPLOAD_AT_ONCE = _script("upload_at_once.js")
 
 
 def install_bokehjs_patches(doc):

@@ -33,7 +33,7 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from explorer_change import start_explorer  # the same server start, its printed URL
+from servers import start_explorer  # the same server start, its printed URL
 
 TARGET_S = 2.0
 CHROMIUM = "/usr/bin/chromium"

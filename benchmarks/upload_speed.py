@@ -42,7 +42,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent))
 from app_latency import cpu_seconds
-from explorer_change import start_explorer, stop
+from servers import start_explorer, stop
 
 from tests.ui.bokeh_page import EXPLORER_TITLES, READY_JS, SETTLE_JS
 

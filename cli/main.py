@@ -8,17 +8,18 @@ import argparse
 import sys
 
 from . import commands
+from . import parser as cli_parser
 from .commands import InputError
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = commands.build_parser()
-    sv = commands.subcommands(parser).add_parser(
+    parser = cli_parser.build_parser()
+    sv = cli_parser.subcommands(parser).add_parser(
         "serve",
         help="start the explorer in the browser (embedded defaults, no setup)",
         description="Start the Bushing Explorer web app and print its URL.",
     )
-    sv.add_argument("--port", type=commands._count("--port", 0), default=5006, metavar="P", help="default 5006")
+    sv.add_argument("--port", type=cli_parser._count("--port", 0), default=5006, metavar="P", help="default 5006")
     sv.add_argument(
         "--address", default="localhost", metavar="A",
         help="interface to listen on (default localhost; 0.0.0.0 for every interface)",

@@ -7,7 +7,7 @@ from __future__ import annotations
 import holoviews as hv
 import numpy as np
 
-from .. import curves, units
+from .. import curves, report_curves, units
 from .style import (
     amplitude_curves,
     dimensions,
@@ -57,10 +57,10 @@ def misfit_map(m: dict, column: str, title: str, dims: dict, limit: float, png: 
 
 def report_overlays(stages: dict, groups: list, misfits: dict, mode: str) -> dict:
     """The report's plots from their data (display units): ``"gap"`` (one plot: the gap after each
-    step, ``stages`` as :func:`app.curves.gap_stages`), ``"curves"`` (|K| and the loss factor:
-    data, baseline, final model; ``groups`` as :func:`app.curves.curve_groups`) and ``"maps"``
+    step, ``stages`` as :func:`app.report_curves.gap_stages`), ``"curves"`` (|K| and the loss factor:
+    data, baseline, final model; ``groups`` as :func:`app.report_curves.curve_groups`) and ``"maps"``
     (the misfit before, then after: |K| in % and the loss factor each, on one colour scale per
-    quantity; ``misfits``: "baseline" and "final", each as :func:`app.curves.misfit_points`);
+    quantity; ``misfits``: "baseline" and "final", each as :func:`app.report_curves.misfit_points`);
     ``"groups"`` the curves' amplitude groups."""
     base, final = misfits["baseline"], misfits["final"]
     ranges = {"gap": (0.0, 1.1 * max(float(np.max(stages["gap"])), stages["noise"] or 0.0) or 1.0),
@@ -80,8 +80,8 @@ def report_overlays(stages: dict, groups: list, misfits: dict, mode: str) -> dic
 
 def diagnosis_overlays(diagnosis) -> dict:
     """The plots of a :class:`core.identify.diagnose.Diagnosis` (:func:`report_overlays`)."""
-    return report_overlays(curves.gap_stages(diagnosis), curves.curve_groups(diagnosis),
-                           {which: curves.misfit_points(diagnosis, which) for which in ("baseline", "final")},
+    return report_overlays(report_curves.gap_stages(diagnosis), report_curves.curve_groups(diagnosis),
+                           {which: report_curves.misfit_points(diagnosis, which) for which in ("baseline", "final")},
                            diagnosis.final.design.mode)
 
 
