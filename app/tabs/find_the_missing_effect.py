@@ -51,6 +51,10 @@ def effect_units(effect: str, mode: str) -> dict[str, str]:
     return {key: p.unit_in(mode) for p in EFFECTS[effect].parameters for key in (p.name, f"{effect}.{p.name}")}
 
 
+PLOT_GROUPS = ("gap", "curves", "maps")  # the report's plots, in the order the page shows them
+PLOT_COLUMNS = {"gap": 1, "curves": 2, "maps": 2}
+
+
 class DiagnosisView(pn.viewable.Viewer):
     """Data → baseline → diagnosis → the final model in the explorer."""
 
@@ -89,6 +93,7 @@ class DiagnosisView(pn.viewable.Viewer):
             callback=lambda: io.StringIO(state.predictions_csv()), filename="bushing-predictions.csv",
             label="Predictions (CSV)", disabled=True)
         self.live: dict[str, LivePlot] = {}  # "gap", "curves", "maps": built with the first result
+        self._prepared = 0  # how many data sets the plots were made ready for: a newer one stops an older
         self._plot_holders = {name: pn.Column(sizing_mode="stretch_width") for name in ("gap", "curves", "maps")}
         self._results = pn.Column(
             "### 3. What the diagnosis found",
@@ -146,34 +151,55 @@ class DiagnosisView(pn.viewable.Viewer):
 
     def _on_data(self, *_events):
         """New data: the report's plots are made ready for them once the data are on the page
-        (:meth:`_prepare`, on the next tick of a served page: the data's message goes first)."""
-        doc = pn.state.curdoc
-        if doc is not None and doc.session_context is not None:
-            doc.add_next_tick_callback(lambda: update_or_keep("DiagnosisView prepared no plots", self._prepare))
-        else:
-            update_or_keep("DiagnosisView prepared no plots", self._prepare)
+        (:meth:`_pending`, on the next ticks of a served page: the data's message goes first,
+        then one group of plots a tick, so that a click on *Diagnose* waits for one group at most)."""
+        self._prepared += 1
+        generation, doc = self._prepared, pn.state.curdoc
+        served = doc is not None and doc.session_context is not None
 
-    def _prepare(self):
-        """The report's plots built (hidden) with the shape a diagnosis of the loaded data will give
-        them (:func:`app.plotting.find_the_missing_effect.pending_overlays`): the report then writes
-        its numbers into them (:meth:`app.live.LivePlot.show`) instead of HoloViews building seven
-        plots after the work (measured: ``benchmarks/diagnosis_report_cpu.py``)."""
+        def prepare(i: int, overlays: dict | None = None):
+            if generation != self._prepared or i >= len(PLOT_GROUPS):
+                return  # newer data came, or every group is built
+            if overlays is None:
+                overlays = self._pending()
+                if overlays is None:
+                    return
+            update_or_keep("DiagnosisView prepared no plots", lambda: self._plot(PLOT_GROUPS[i], overlays))
+            if served:
+                doc.add_next_tick_callback(lambda: prepare(i + 1, overlays))
+            else:
+                prepare(i + 1, overlays)
+
+        if served:
+            doc.add_next_tick_callback(lambda: prepare(0))
+        else:
+            prepare(0)
+
+    def _pending(self) -> dict | None:
+        """The report's plots with the shape a diagnosis of the loaded data will give them
+        (:func:`app.plotting.find_the_missing_effect.pending_overlays`): the report then writes its
+        numbers into them (:meth:`app.live.LivePlot.show`) instead of HoloViews building seven
+        plots after the work (measured: ``benchmarks/diagnosis_report_cpu.py``). None without data."""
         s = self.state
         data = None if s.data is None or s.running else s.data.of_mode(s.explorer.design.mode)
         if data is None or len(data) == 0:
-            return
-        self._plots(pending_overlays(data, s.explorer.design.mode))
+            return None
+        return pending_overlays(data, s.explorer.design.mode)
 
     def _plots(self, overlays: dict):
         """``overlays`` (as :func:`app.plotting.find_the_missing_effect.report_overlays`) shown in
         the report's plots, built the first time."""
-        for name, cols in (("gap", 1), ("curves", 2), ("maps", 2)):
-            live = self.live.get(name)
-            if live is None:
-                self.live[name] = live = LivePlot(overlays[name])
-                self._plot_holders[name].objects = [live.grid(cols)]
-            else:
-                live.show(overlays[name])
+        for name in PLOT_GROUPS:
+            self._plot(name, overlays)
+
+    def _plot(self, name: str, overlays: dict):
+        """The group ``name`` of the report's plots showing ``overlays[name]``, built the first time."""
+        live = self.live.get(name)
+        if live is None:
+            self.live[name] = live = LivePlot(overlays[name])
+            self._plot_holders[name].objects = [live.grid(PLOT_COLUMNS[name])]
+        else:
+            live.show(overlays[name])
 
     # ---- refresh -------------------------------------------------------------------------------
 
