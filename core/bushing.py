@@ -31,7 +31,7 @@ from .parameters import MODE, THESIS_MODES
 from .parts import Material
 from .registry import parameter
 from .response import ComplexStiffness, loss_factor
-from .shape import shape_factor, strain_factor  # noqa: F401 (re-exported)
+from .shape import bulk_factor, shape_factor, strain_factor  # noqa: F401 (re-exported)
 from .slices import continuum_node_count, continuum_nodes, slice_nodes, solve_series
 
 Route = Literal["analytic", "time-domain"]
@@ -240,14 +240,29 @@ def check_measured_amplitude(design: Design, amplitude, what: str = "measured am
                          f"{float(np.min(x)):.3g} {unit}: are the units those of docs/files.md (m or rad)?")
 
 
-def equivalent_stiffness(modulus, s, c, frequency_hz, amplitude):
+def equivalent_stiffness(modulus, s, c, frequency_hz, amplitude, bulk=None):
     """K = S·µ_eq(f, ε_eq) at ε_eq = c·x̂: the single equivalent modulus (eqs 14–18), broadcast
     over every argument. ``modulus`` is µ_eq(frequency_hz, strain_amplitude) in Pa (e.g.
     :func:`modulus_function`'s, or :func:`core.material.equivalent_modulus` of a material);
     ``s`` the shape factor (m or m³/rad) and ``c`` the strain factor (1/m or 1/rad). S, c and the
     parameters inside ``modulus`` may be arrays, e.g. one value per Monte Carlo sample shaped
-    (n, 1, …) against the points; the drive ``amplitude`` is in m or rad."""
-    return s * modulus(frequency_hz, c * amplitude)  # eqs 14, 15 inside, 17, 18 outside
+    (n, 1, …) against the points; the drive ``amplitude`` is in m or rad. ``bulk``: a
+    compressible rubber's factor S(µ*/K)/S of µ_eq (:func:`bulk_correction`), or None."""
+    mu = modulus(frequency_hz, c * amplitude)  # eqs 14, 15 inside
+    return s * mu if bulk is None else s * mu * bulk(mu)  # eqs 17, 18
+
+
+def bulk_correction(design: Design, bulk_modulus=None):
+    """A compressible rubber's correction of K = S·µ_eq, by the correspondence principle: the
+    function µ_eq ↦ S(µ_eq/K)/S (:func:`core.shape.bulk_factor`), the complex µ_eq (the loss,
+    friction's tangent included) against the elastic bulk modulus K; None for a design without
+    ``bulk_modulus`` (nearly incompressible, K = 5000 µ: S as it is). ``bulk_modulus`` (Pa, may
+    be an array broadcast against µ_eq) replaces the design's."""
+    bulk = design.material.bulk_modulus if bulk_modulus is None else bulk_modulus
+    if bulk is None:
+        return None
+    geometry, mode, kind = design.geometry, design.mode, design.shape_kind
+    return lambda mu: bulk_factor(geometry, mode, kind, mu / bulk)
 
 
 def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | str = 1,
@@ -310,7 +325,7 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
         k = wave_stiffness(mode, geo.inner_radius, geo.outer_radius, geo.length,
                            modulus(f, design.strain(x)), f, effects["wave_effects"]["density"])
     elif slices == 1:
-        k = equivalent_stiffness(modulus, s, c, f, x)
+        k = equivalent_stiffness(modulus, s, c, f, x, bulk_correction(design))
     else:
         nodes = continuum_nodes(geo, mode) if slices == "continuum" else slice_nodes(geo, mode, slices)
         fp, xp = (np.broadcast_to(v, shape).ravel() for v in (f, x))
@@ -465,8 +480,10 @@ def branch_stiffness(design: Design, frequency_hz, amplitude) -> dict[str, np.nd
     f = positive_values("frequency_hz", frequency_hz)[None, :]
     x = positive_values("amplitude", amplitude)[:, None]
     s, eps = design.shape_factor, design.strain(x)
-    return {name: s * modulus for name, modulus in  # eqs 17, 18 branch by branch
-            branch_moduli(design.material, design.effect_parameters, f, eps).items()}
+    moduli = branch_moduli(design.material, design.effect_parameters, f, eps)
+    bulk = bulk_correction(design)  # a compressible rubber: the whole µ_eq's factor on each branch
+    factor = 1.0 if bulk is None else bulk(sum(moduli.values()))
+    return {name: s * modulus * factor for name, modulus in moduli.items()}  # eqs 17, 18 branch by branch
 
 
 def cache_info():

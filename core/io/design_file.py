@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from ..design import Design
-from ..parameters import GEOMETRY, MATERIAL, MODES
+from ..parameters import GEOMETRY, MATERIAL, MODES, OPTIONAL
 from ..parts import Geometry, Material
 from ..rules import (
     BAD_CHOICE,
@@ -56,7 +56,11 @@ def design_from_dict(data: Any) -> Design:
     """Build a :class:`Design` from a design-file object (docs/files.md), refusing anything off."""
     _exact_keys("", data, _TOP_KEYS, ("mode", "geometry", "material"))
     _exact_keys("geometry", data["geometry"], GEOMETRY, GEOMETRY)
-    _exact_keys("material", data["material"], MATERIAL, MATERIAL)
+    _exact_keys("material", data["material"], MATERIAL + OPTIONAL, MATERIAL)
+    for key in OPTIONAL:
+        if key in data["material"] and data["material"][key] is None:
+            raise DesignError(f"material.{key}", "must be a number (leave the key out for a nearly incompressible "
+                              "rubber, K = 5000 µ)", BAD_TYPE)
     if "fit" in data and not isinstance(data["fit"], Mapping):  # a fitted file's report: kept aside
         raise DesignError("fit", "must be an object (the report of `bushing fit`)", BAD_TYPE)
     if not isinstance(data["mode"], str):
