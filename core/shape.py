@@ -290,11 +290,19 @@ def shape_factor(geometry: Geometry, mode: str, shape: str | None = None) -> flo
 
 def long_radial_compressible(a: float, b: float, L: float, x):
     """The long radial shape factor (plane strain) of a compressible rubber, µ/K = ``x`` (real,
-    or complex by the correspondence principle): 8πL(1 − ν) / ((3 − 4ν) ln(b/a) − (b² − a²)/(b² + a²))
-    with Poisson's ratio ν = (3 − 2x) / (2(3 + x)); at x = 0 the incompressible closed form."""
+    or complex by the correspondence principle):
+
+        S = 8πL (1 − ν) / ((3 − 4ν) ln(b/a) − (b² − a²) / ((3 − 4ν)(b² + a²))),
+
+    with Poisson's ratio ν = (3 − 2x) / (2(3 + x)): the exact solution of Navier's equations for
+    the inner tube displaced across the axis (the displacement's first circular harmonic; four
+    constants from the bonded tubes). At x = 0 it is the incompressible closed form; for a thin
+    wall t = b − a it tends to πa(λ + 3µ)/t per length (compression λ + 2µ and shear µ of the
+    layer)."""
     a, b, L = _radii(a, b, L)
     nu = (3.0 - 2.0 * x) / (2.0 * (3.0 + x))
-    return 8.0 * math.pi * L * (1.0 - nu) / ((3.0 - 4.0 * nu) * math.log(b / a) - (b * b - a * a) / (b * b + a * a))
+    k = 3.0 - 4.0 * nu
+    return 8.0 * math.pi * L * (1.0 - nu) / (k * math.log(b / a) - (b * b - a * a) / (k * (b * b + a * a)))
 
 
 def bulk_factor(geometry: Geometry, mode: str, shape: str | None, x):
