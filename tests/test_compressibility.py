@@ -13,7 +13,13 @@ from scipy.integrate import solve_ivp
 
 from core import PAPER_B, DesignError, stiffness
 from core.io.design_file import design_from_dict, dumps_design, loads_design
-from core.shape import BULK_RATIO, converged_shape_factor, long_radial_compressible, long_shape_factor, table
+from core.shape import (
+    BULK_RATIO,
+    converged_shape_factor,
+    long_radial_compressible,
+    long_shape_factor,
+    table,
+)
 
 
 @functools.cache
