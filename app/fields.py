@@ -15,7 +15,15 @@ import param
 from core import PAPER_B, Design, DesignError, Geometry, Material
 from core.bushing import factors
 from core.numbers import format_number, range_problem, rounded
-from core.parameters import BY_NAME, DEFAULT_SHAPE, GEOMETRY, MATERIAL, OPTIONAL, PARAMETERS, DesignParameter
+from core.parameters import (
+    BY_NAME,
+    DEFAULT_SHAPE,
+    GEOMETRY,
+    MATERIAL,
+    OPTIONAL,
+    PARAMETERS,
+    DesignParameter,
+)
 from core.parts import MAX_MODULUS, SIZE_RANGE, STRAIN_HALF_RANGE, as_dict
 from core.rules import NOT_POSITIVE, ORDER_RANGE, OUT_OF_RANGE, OUTER_NOT_LARGER
 from core.shape import OutsideTable, table
