@@ -134,7 +134,7 @@ PARAMETERS: tuple[DesignParameter, ...] = (
     # known by default in fits, identified only when a fit frees it (radial data are sensitive)
     DesignParameter("bulk_modulus", "material", "K", Unit("Pa", "GPa", 1e9), "K", "Bulk modulus K",
                     "Bulk modulus K of the rubber (filled rubber about 2 GPa); empty: nearly incompressible, "
-                    "K = 5000 µ.", "bulk modulus K", (1e5, 1e12), step=0.1, optional=True),
+                    "K = 5000 µ.", "bulk modulus K", (1e7, 1e12), step=0.1, optional=True),
 )
 BY_NAME = {p.name: p for p in PARAMETERS}
 GEOMETRY = tuple(p.name for p in PARAMETERS if p.group == "geometry")
