@@ -194,3 +194,20 @@ def test_a_joint_fit_of_axial_and_radial_data_identifies_the_bulk_modulus():
     axial = fit_global(start.replace(bulk_modulus=5e9), data.select(data.modes("axial") == "axial"),
                        free=MATERIAL + ("bulk_modulus",))
     assert "bulk_modulus" in axial.undetermined
+
+
+def test_the_card_says_how_far_each_direction_is_from_an_incompressible_rubber():
+    """core.card.against_incompressible against the card of the same bushing with the stiffest
+    bulk modulus a design takes (1e12 Pa: K/µ 4×10⁵, within 0.03 % of the limit here)."""
+    from core.card import against_incompressible, card
+
+    design = THIN.replace(bulk_modulus=2.0e9)
+    rows = card(design, 10.0, 1e-4, 1e-2)
+    stiff = {r["mode"]: r for r in card(design.replace(bulk_modulus=1e12), 10.0, 1e-4, 1e-2)}
+    moved = against_incompressible(design, 10.0, rows)
+    for r in rows:
+        far = stiff[r["mode"]]
+        assert moved[r["mode"]][0] == pytest.approx(r["magnitude"] / far["magnitude"] - 1, abs=3e-4)
+        assert moved[r["mode"]][1] == pytest.approx(r["loss_factor"] / far["loss_factor"] - 1, abs=3e-4)
+    assert moved["torsion"] == (0.0, 0.0)
+    assert moved["radial"][0] < -0.1 and moved["radial"][0] < moved["conical"][0] < moved["axial"][0] <= 0
