@@ -211,3 +211,20 @@ def test_the_card_says_how_far_each_direction_is_from_an_incompressible_rubber()
         assert moved[r["mode"]][1] == pytest.approx(r["loss_factor"] / far["loss_factor"] - 1, abs=3e-4)
     assert moved["torsion"] == (0.0, 0.0)
     assert moved["radial"][0] < -0.1 and moved["radial"][0] < moved["conical"][0] < moved["axial"][0] <= 0
+
+
+def test_the_command_line_fits_the_bulk_modulus_when_asked(tmp_path, capsys):
+    from cli.main import main
+    from core import write_design
+    from tests.test_joint import multi_mode
+
+    data = multi_mode(THIN.replace(bulk_modulus=1.5e9), modes=("axial", "radial"), per_amplitude=20)
+    (tmp_path / "ar.csv").write_text(data.to_csv(), encoding="utf-8")
+    write_design(THIN.replace(shear_modulus=2e6), tmp_path / "thin.json")
+    assert main(["fit", str(tmp_path / "ar.csv"), "--design", str(tmp_path / "thin.json"), "--free-bulk-modulus"]) in (0, None)
+    report = json.loads(capsys.readouterr().out)
+    low, high = report["fit"]["intervals"]["bulk_modulus"]
+    assert low < 1.5e9 < high and "bulk_modulus" in report["fit"]["standard_errors"]
+    assert main(["fit", str(tmp_path / "ar.csv"), "--design", str(tmp_path / "thin.json")]) in (0, None)
+    known = json.loads(capsys.readouterr().out)
+    assert "bulk_modulus" not in known["material"] and "bulk_modulus" not in known["fit"]["standard_errors"]
