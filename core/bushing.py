@@ -427,10 +427,23 @@ STRUCTURAL_EFFECTS = ("inertia", "nonuniform_strain", "wave_effects")
 
 
 def material_model(design: Design) -> Design:
-    """``design`` without its stiffness-level effects (:data:`STRUCTURAL_EFFECTS`): the material
-    model with its material-level effects, for loops and branch-by-branch views."""
+    """``design`` without its stiffness-level effects (:data:`STRUCTURAL_EFFECTS`) and without a
+    bulk modulus (the bulk spring in series is no branch of the material): the material model
+    with its material-level effects, for loops and branch-by-branch views."""
     kept = {eid: p for eid, p in design.effect_parameters.items() if eid not in STRUCTURAL_EFFECTS}
+    if design.material.bulk_modulus is not None:
+        design = design.replace(bulk_modulus=None)
     return design if len(kept) == len(design.effects) else design.replace(effects=kept)
+
+
+def refuse_compressible(design: Design, what: str) -> None:
+    """ValueError if ``design``'s bulk modulus changes its stiffness (radial, conical, a finite
+    axial bushing): ``what`` is computed for the material's branches alone, and the bulk spring
+    in series is none of them."""
+    pure_shear = design.mode == "torsion" or (design.mode == "axial" and design.shape_kind == "long")
+    if design.material.bulk_modulus is not None and not pure_shear:
+        raise ValueError(f"material.bulk_modulus: {what} is computed from the material branches of an "
+                         f"incompressible rubber; leave bulk_modulus out for it (the stiffness honours it)")
 
 
 def refuse_structural_effects(design: Design, what: str, allowed=()) -> None:

@@ -228,3 +228,23 @@ def test_the_command_line_fits_the_bulk_modulus_when_asked(tmp_path, capsys):
     assert main(["fit", str(tmp_path / "ar.csv"), "--design", str(tmp_path / "thin.json")]) in (0, None)
     known = json.loads(capsys.readouterr().out)
     assert "bulk_modulus" not in known["material"] and "bulk_modulus" not in known["fit"]["standard_errors"]
+
+
+def test_a_loop_is_the_material_s_and_says_so_for_a_compressible_wall():
+    """The branch-by-branch loop is the incompressible rubber's: a radial design with a bulk
+    modulus is refused by name (the stiffness honours K); torsion and the long axial bushing,
+    pure shear, draw theirs; the explorer's loop is the material model's."""
+    from app.curves import hysteresis_loop
+    from core.bushing import material_model
+    from core.loops import loop
+
+    radial = THIN.in_mode("radial").replace(bulk_modulus=2e9)
+    with pytest.raises(ValueError, match="material.bulk_modulus: the branch-by-branch hysteresis loop"):
+        loop(radial, 10.0, 1e-4)
+    assert material_model(radial).material.bulk_modulus is None
+    drawn = hysteresis_loop(radial, 10.0, 0.1)
+    expected = loop(radial.replace(bulk_modulus=None), 10.0, 1e-4, 200)
+    assert np.array_equal(drawn["force"][:-1], expected.force)
+    for mode in ("torsion", "axial"):
+        design = THIN.in_mode(mode).replace(bulk_modulus=2e9)
+        assert np.array_equal(loop(design, 10.0, 1e-3).force, loop(design.replace(bulk_modulus=None), 10.0, 1e-3).force)

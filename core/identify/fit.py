@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..bushing import check_measured_amplitude, stiffness_points
+from ..bushing import check_measured_amplitude, refuse_compressible, stiffness_points
 from ..data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from ..design import Design
 from ..loops import loop_force
@@ -385,6 +385,7 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     if data is not None:
         check_data_amplitudes(design, data)  # the measured amplitudes, for this bushing
     if loop is not None:
+        refuse_compressible(design, "a fit to a measured loop")
         check_measured_amplitude(design, loop.harmonic()[1], "the loop's amplitude")
         loop.check_force()  # after the amplitude: a displacement in wrong units is named as such
     n = (0 if data is None else 2 * len(data)) + (0 if loop is None else loop.force.size)
