@@ -24,7 +24,7 @@ from core.parameters import (
     PARAMETERS,
     DesignParameter,
 )
-from core.parts import MAX_MODULUS, SIZE_RANGE, STRAIN_HALF_RANGE, as_dict
+from core.parts import MAX_MODULUS, SIZE_RANGE, STRAIN_HALF_RANGE, as_dict, check_bulk_ratio
 from core.rules import NOT_POSITIVE, ORDER_RANGE, OUT_OF_RANGE, OUTER_NOT_LARGER
 from core.shape import OutsideTable, table
 
@@ -77,7 +77,7 @@ def design_from_fields(fields: Mapping, shown: Design, mode: str, shape: str | N
         values[p.name] = float(p.unit.to_si(v))
         try:  # the core's own rule for this field alone (cross-field rules below)
             if p.group == "material":
-                Material(**{**as_dict(shown.material), p.name: values[p.name]})
+                check_bulk_ratio(Material(**{**as_dict(shown.material), p.name: values[p.name]}))
             elif not SIZE_RANGE[0] <= values[p.name] <= SIZE_RANGE[1]:  # this field alone
                 Geometry(**{**as_dict(shown.geometry), p.name: values[p.name]})
         except DesignError as exc:
@@ -92,6 +92,7 @@ def design_from_fields(fields: Mapping, shown: Design, mode: str, shape: str | N
     try:
         geometry = Geometry(**{n: values[n] for n in GEOMETRY})
         material = Material(**{n: values[n] for n in MATERIAL + OPTIONAL if n in values})
+        check_bulk_ratio(material)
         design = Design(mode, geometry, material, effects=effects, shape=shape)
         factors(design)  # the shape factor exists for this geometry (the FE table's range)
     except DesignError as exc:

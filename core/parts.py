@@ -90,8 +90,8 @@ class Material:
     ------
     DesignError
         If a value is no finite number, a modulus is not in (0, :data:`MAX_MODULUS`] (Pa), α is
-        not in (0, 1], ε½ not in :data:`STRAIN_HALF_RANGE` or K/µ not in
-        :data:`BULK_RATIO_RANGE`; it names the key.
+        not in (0, 1] or ε½ not in :data:`STRAIN_HALF_RANGE`; it names the key (K/µ is an input
+        rule, :func:`check_bulk_ratio`).
     """
 
     shear_modulus: float
@@ -118,20 +118,23 @@ class Material:
                 if value > MAX_MODULUS:
                     raise DesignError(key, f"must be at most {MAX_MODULUS:g} Pa, got {value!r}", OUT_OF_RANGE)
             object.__setattr__(self, f.name, value)
-        if self.bulk_modulus is not None:
-            low, high = BULK_RATIO_RANGE
-            ratio = self.bulk_modulus / self.shear_modulus
-            if not low <= ratio <= high:
-                raise DesignError(
-                    "material.bulk_modulus",
-                    f"must lie between {low:g} and {high:g} times the shear modulus (Poisson's ratio 0.49 to "
-                    f"0.4999995; filled rubber about 2e9 Pa), got K/µ = {ratio:.3g} (K = {self.bulk_modulus!r} Pa, "
-                    f"µ = {self.shear_modulus!r} Pa)", OUT_OF_RANGE)
 
-    @property
-    def compliance_ratio(self) -> float | None:
-        """µ/K, the elastic shear modulus over the bulk modulus; None without a bulk modulus."""
-        return None if self.bulk_modulus is None else self.shear_modulus / self.bulk_modulus
+
+def check_bulk_ratio(material: Material) -> None:
+    """The input rule of the bulk modulus against the shear modulus: K/µ within
+    :data:`BULK_RATIO_RANGE` (a design file, the explorer's fields, a link). A fit may wander past
+    it while it searches (the model stays finite there); what people give may not. DesignError
+    naming ``material.bulk_modulus`` otherwise."""
+    if material.bulk_modulus is None:
+        return
+    low, high = BULK_RATIO_RANGE
+    ratio = material.bulk_modulus / material.shear_modulus
+    if not low <= ratio <= high:
+        raise DesignError(
+            "material.bulk_modulus",
+            f"must lie between {low:g} and {high:g} times the shear modulus (Poisson's ratio 0.49 to "
+            f"0.4999995; filled rubber about 2e9 Pa), got K/µ = {ratio:.3g} (K = {material.bulk_modulus!r} Pa, "
+            f"µ = {material.shear_modulus!r} Pa)", OUT_OF_RANGE)
 
 
 def as_dict(value) -> dict[str, float]:

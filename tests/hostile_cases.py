@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 DESIGN = {"name": "corpus", "mode": "axial", "geometry": {"inner_radius": 0.02, "outer_radius": 0.035, "length": 0.09},
           "material": {"shear_modulus": 2420000.0, "fractional_coefficient": 600000.0, "fractional_order": 0.2,
-                       "friction_stress_max": 19200.0, "friction_strain_half": 0.004, "bulk_modulus": 2.0e9}}
+                       "friction_stress_max": 19200.0, "friction_strain_half": 0.004}}
 _A, _B = DESIGN["geometry"]["inner_radius"], DESIGN["geometry"]["outer_radius"]
 STRAIN_FACTOR = 1.0 / math.sqrt(2.0 * (_B * _B - _A * _A) * math.log(_B / _A))  # ε_eq = c·x, eq 15
 # JSON texts put in place of a number

@@ -91,6 +91,11 @@ def design_cases(folder: Path, files: dict, good: Path) -> list[Case]:
                 text = json.dumps(DESIGN).replace(f'"{key}": {json.dumps(DESIGN[section][key])}', f'"{key}": {bad}')
                 rule = _number_rule(f"{section}.{key}", bad, DESIGN_RULES[key])
                 texts[f"{section}.{key} = {bad[:20]}"] = (text, rule)
+    with_bulk = {**DESIGN, "material": {**DESIGN["material"], "bulk_modulus": 2.0e9}}  # the optional K
+    for bad in BAD_NUMBERS:
+        text = json.dumps(with_bulk).replace('"bulk_modulus": 2000000000.0', f'"bulk_modulus": {bad}')
+        texts[f"material.bulk_modulus = {bad[:20]}"] = (
+            text, _number_rule("material.bulk_modulus", bad, DESIGN_RULES["bulk_modulus"]))
     for eid, pname in EFFECT_CASES:
         for bad in BAD_NUMBERS[:10]:
             words = _number_rule(f"effects.{eid}.{pname}", bad, lambda v: "≥ 0" if v < 0 else None)

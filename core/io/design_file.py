@@ -13,7 +13,7 @@ from typing import Any
 
 from ..design import Design
 from ..parameters import GEOMETRY, MATERIAL, MODES, OPTIONAL
-from ..parts import Geometry, Material
+from ..parts import Geometry, Material, check_bulk_ratio
 from ..rules import (
     BAD_CHOICE,
     BAD_TYPE,
@@ -65,10 +65,12 @@ def design_from_dict(data: Any) -> Design:
         raise DesignError("fit", "must be an object (the report of `bushing fit`)", BAD_TYPE)
     if not isinstance(data["mode"], str):
         raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {data['mode']!r}", BAD_CHOICE)
+    material = Material(**data["material"])
+    check_bulk_ratio(material)
     return Design(
         mode=data["mode"],
         geometry=Geometry(**data["geometry"]),
-        material=Material(**data["material"]),
+        material=material,
         name=data.get("name"),
         effects=data.get("effects", {}),
         shape=data.get("shape"),
