@@ -15,8 +15,16 @@ import param
 from core import PAPER_B, Design, DesignError, Geometry, Material
 from core.bushing import factors
 from core.numbers import format_number, range_problem, rounded
-from core.parameters import BY_NAME, DEFAULT_SHAPE, GEOMETRY, MATERIAL, PARAMETERS, DesignParameter
-from core.parts import MAX_MODULUS, SIZE_RANGE, STRAIN_HALF_RANGE, as_dict
+from core.parameters import (
+    BY_NAME,
+    DEFAULT_SHAPE,
+    GEOMETRY,
+    MATERIAL,
+    OPTIONAL,
+    PARAMETERS,
+    DesignParameter,
+)
+from core.parts import MAX_MODULUS, SIZE_RANGE, STRAIN_HALF_RANGE, as_dict, check_bulk_ratio
 from core.rules import NOT_POSITIVE, ORDER_RANGE, OUT_OF_RANGE, OUTER_NOT_LARGER
 from core.shape import OutsideTable, table
 
@@ -24,6 +32,7 @@ from core.shape import OutsideTable, table
 DESIGN_FIELDS: dict[str, DesignParameter] = {p.field: p for p in PARAMETERS}
 GEOMETRY_FIELDS = tuple(BY_NAME[n].field for n in GEOMETRY)
 MATERIAL_FIELDS = tuple(BY_NAME[n].field for n in MATERIAL)
+OPTIONAL_FIELDS = tuple(BY_NAME[n].field for n in OPTIONAL)  # may be left empty (None)
 # design-error key → the field to show the message beside
 ERROR_FIELD = {f"{p.group}.{p.name}": p.field for p in PARAMETERS}
 # the fields named by the rule b > a, and by a geometry outside the finite-length table
@@ -33,7 +42,8 @@ _INNER, _OUTER, _LENGTH = BY_NAME["inner_radius"].field, BY_NAME["outer_radius"]
 def display_values(design: Design) -> dict[str, float]:
     """The fields' values for ``design`` (display units, to 12 digits: no 19.200000000000003; the
     fields show them to their quantity's digits, a link writes :data:`core.numbers.LINK_DIGITS`)."""
-    return {name: rounded(p.unit.to_display(design.value(p.name)), 12) for name, p in DESIGN_FIELDS.items()}
+    values = {name: design.value(p.name) for name, p in DESIGN_FIELDS.items()}
+    return {name: None if v is None else rounded(DESIGN_FIELDS[name].unit.to_display(v), 12) for name, v in values.items()}
 
 
 def _field(p: DesignParameter, default: float) -> param.Number:
@@ -59,13 +69,15 @@ def design_from_fields(fields: Mapping, shown: Design, mode: str, shape: str | N
     values: dict[str, float] = {}
     for name, p in DESIGN_FIELDS.items():
         v = fields[name]
+        if v is None and p.optional:  # left empty: the rubber's default (the bulk modulus: 5000 µ)
+            continue
         if v is None or not isinstance(v, (int, float)) or not math.isfinite(v):
             errors[name] = "Enter a number."
             continue
         values[p.name] = float(p.unit.to_si(v))
         try:  # the core's own rule for this field alone (cross-field rules below)
             if p.group == "material":
-                Material(**{**as_dict(shown.material), p.name: values[p.name]})
+                check_bulk_ratio(Material(**{**as_dict(shown.material), p.name: values[p.name]}))
             elif not SIZE_RANGE[0] <= values[p.name] <= SIZE_RANGE[1]:  # this field alone
                 Geometry(**{**as_dict(shown.geometry), p.name: values[p.name]})
         except DesignError as exc:
@@ -79,7 +91,8 @@ def design_from_fields(fields: Mapping, shown: Design, mode: str, shape: str | N
         return None, errors
     try:
         geometry = Geometry(**{n: values[n] for n in GEOMETRY})
-        material = Material(**{n: values[n] for n in MATERIAL})
+        material = Material(**{n: values[n] for n in MATERIAL + OPTIONAL if n in values})
+        check_bulk_ratio(material)
         design = Design(mode, geometry, material, effects=effects, shape=shape)
         factors(design)  # the shape factor exists for this geometry (the FE table's range)
     except DesignError as exc:

@@ -15,7 +15,7 @@ from core.parameters import DEFAULT_SHAPE
 from core.rules import RuleError
 
 from .curves import amplitude_bounds
-from .fields import DESIGN_FIELDS, GEOMETRY_FIELDS, MATERIAL_FIELDS
+from .fields import DESIGN_FIELDS, GEOMETRY_FIELDS, MATERIAL_FIELDS, OPTIONAL_FIELDS
 from .number_field import NumberField, NumberText
 from .state import PRESETS, ExplorerState
 from .units import OPERATING_FREQUENCIES, amplitude_unit
@@ -45,6 +45,8 @@ class FloatSlider(pn.widgets.FloatSlider):
 
 
 IMMEDIATE = (FloatInput, IntInput, FloatSlider, NumberText)  # the app's number widgets, for app.patches
+# the hint of an optional field left empty (the bulk modulus): what an empty field means
+OPTIONAL_HINT = "empty: nearly incompressible (5000 µ)"
 
 
 class LogSlider(pn.viewable.Viewer):
@@ -141,9 +143,12 @@ class DesignInputs(pn.viewable.Viewer):
         super().__init__(**params)
         self.state = state
         self.fields = {
-            name: NumberField(state, name, label=state.param[name].label, quantity="parameter", blank=False,
+            name: NumberField(state, name, label=state.param[name].label, quantity="parameter",
+                              blank=name in DESIGN_FIELDS and DESIGN_FIELDS[name].optional,
                               unit=DESIGN_FIELDS[name].unit.display if name in DESIGN_FIELDS else "Hz",
-                              sizing_mode="stretch_width")
+                              sizing_mode="stretch_width",
+                              **({"placeholder": OPTIONAL_HINT} if name in DESIGN_FIELDS and DESIGN_FIELDS[name].optional
+                                 else {}))
             for name in (*DESIGN_FIELDS, "freq_min", "freq_max")
         }
         self.widgets = self.fields  # kept name: a field's ``value`` is the state's
@@ -191,7 +196,7 @@ class DesignInputs(pn.viewable.Viewer):
 
     def __panel__(self):
         geometry = [self._field(n) for n in GEOMETRY_FIELDS]
-        material = [self._field(n) for n in MATERIAL_FIELDS]
+        material = [self._field(n) for n in (*MATERIAL_FIELDS, *OPTIONAL_FIELDS)]
         return pn.Column(
             self.preset,
             self.mode,

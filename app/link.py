@@ -93,7 +93,7 @@ def design_query(design: Design) -> dict[str, str]:
     """A design's keys of a link (:data:`DESIGN_KEYS`): the fields in display units, mode,
     shape, effects and name (none unset)."""
     out = {"mode": design.mode, "finite": url_value(design.shape == "finite")}
-    out.update({DESIGN_FIELDS[f].url_key: url_value(v) for f, v in display_values(design).items()})
+    out.update({DESIGN_FIELDS[f].url_key: url_value(v) for f, v in display_values(design).items() if v is not None})
     if design.effects:
         out["effects"] = effects_text(design.portable_effects)
     if design.name:
@@ -106,7 +106,8 @@ def design_from_query(query: dict[str, str], where: str = "") -> Design:
     input panel's rules; else a DesignError naming the first key that breaks one."""
     fields = {}
     for name, p in DESIGN_FIELDS.items():
-        fields[name] = decimal(query.get(p.url_key, ""), where + p.url_key, DesignError)
+        text = query.get(p.url_key, "")
+        fields[name] = None if (p.optional and not text) else decimal(text, where + p.url_key, DesignError)
     effects = parse_effects(query.get("effects", ""))
     mode = query.get("mode", PAPER_B.mode)
     try:

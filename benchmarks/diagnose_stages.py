@@ -1,7 +1,7 @@
 """Where the diagnosis of 150 points spends its work (issue #27, item 16): prints, per stage of
 :func:`core.identify.diagnose.diagnose`, the evaluations of the model (calls of
 :func:`core.bushing.stiffness_points`, each over the fit's points, and the parameter sets of each call of
-:class:`core.bushing.PointsModel`, a finite-difference Jacobian's columns at once) and the CPU seconds
+:class:`core.points.PointsModel`, a finite-difference Jacobian's columns at once) and the CPU seconds
 (``time.process_time``: the machine's load does not change them much, the wall clock's does).
 Asserts nothing.
 

@@ -192,17 +192,24 @@ def _read_measured(paths: list[str], design):
 
 def _cmd_fit(args) -> None:
     from core.identify.fit import fit_global, predicted, selection
+    from core.parameters import MATERIAL
+    from core.shape import BULK_RATIO
 
     design = read_design(args.design)
     data = _read_measured(args.measured, design)
     loop_data = read_loop(args.loop) if args.loop else None
     if loop_data is not None:
         _judged(loop_verdict(design, loop_data, Path(args.loop).name))
+    free = MATERIAL
+    if args.free_bulk_modulus:
+        free = MATERIAL + ("bulk_modulus",)
+        if design.material.bulk_modulus is None:
+            design = design.replace(bulk_modulus=BULK_RATIO * design.material.shear_modulus)
     if args.fit_on is None:
-        result = fit_global(design, data, loop_data)
+        result = fit_global(design, data, loop_data, free=free)
     else:
         chosen = selection(data, design.mode, args.fit_on)
-        result = fit_global(design, data.select(chosen), loop_data)
+        result = fit_global(design, data.select(chosen), loop_data, free=free)
         result = dataclasses.replace(result, prediction=predicted(result, data, chosen, args.fit_on))
     _write_text(result.to_json(), args.output)
     for line in result.warnings:  # the fit succeeded; what the user must know, one line each

@@ -136,6 +136,10 @@ def build_parser() -> argparse.ArgumentParser:
                     help="fit only these rows, predict the rest (the report's `prediction`): "
                     "mode=NAME[+NAME…] and/or amplitude=VALUE[+VALUE…], comma-separated, e.g. "
                     "mode=axial,amplitude=1e-4")
+    ft.add_argument("--free-bulk-modulus", action="store_true",
+                    help="fit the bulk modulus K too (the design's, or 5000 µ, is the start): radial and conical "
+                    "data of a thin wall determine it, axial and torsion do not; the report gives its interval "
+                    "or names it undetermined")
     ft.add_argument("-o", dest="output", metavar="FITTED.json", help="write here, not to stdout")
 
     dg = sub.add_parser(

@@ -16,10 +16,8 @@ the continuum (:mod:`core.slices`) and the stiffness-level effects (:mod:`core.e
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 from dataclasses import dataclass
-from types import SimpleNamespace
 from typing import Literal
 
 import numpy as np
@@ -28,10 +26,8 @@ from . import material as mat
 from .design import Design
 from .effects import EFFECTS, branch_moduli, extended_modulus, inertia_correction, wave_stiffness
 from .parameters import MODE, THESIS_MODES
-from .parts import Material
-from .registry import parameter
 from .response import ComplexStiffness, loss_factor
-from .shape import shape_factor, strain_factor  # noqa: F401 (re-exported)
+from .shape import bulk_factor, shape_factor, strain_factor  # noqa: F401 (re-exported)
 from .slices import continuum_node_count, continuum_nodes, slice_nodes, solve_series
 
 Route = Literal["analytic", "time-domain"]
@@ -240,14 +236,29 @@ def check_measured_amplitude(design: Design, amplitude, what: str = "measured am
                          f"{float(np.min(x)):.3g} {unit}: are the units those of docs/files.md (m or rad)?")
 
 
-def equivalent_stiffness(modulus, s, c, frequency_hz, amplitude):
+def equivalent_stiffness(modulus, s, c, frequency_hz, amplitude, bulk=None):
     """K = S·µ_eq(f, ε_eq) at ε_eq = c·x̂: the single equivalent modulus (eqs 14–18), broadcast
     over every argument. ``modulus`` is µ_eq(frequency_hz, strain_amplitude) in Pa (e.g.
     :func:`modulus_function`'s, or :func:`core.material.equivalent_modulus` of a material);
     ``s`` the shape factor (m or m³/rad) and ``c`` the strain factor (1/m or 1/rad). S, c and the
     parameters inside ``modulus`` may be arrays, e.g. one value per Monte Carlo sample shaped
-    (n, 1, …) against the points; the drive ``amplitude`` is in m or rad."""
-    return s * modulus(frequency_hz, c * amplitude)  # eqs 14, 15 inside, 17, 18 outside
+    (n, 1, …) against the points; the drive ``amplitude`` is in m or rad. ``bulk``: a
+    compressible rubber's factor S(µ*/K)/S of µ_eq (:func:`bulk_correction`), or None."""
+    mu = modulus(frequency_hz, c * amplitude)  # eqs 14, 15 inside
+    return s * mu if bulk is None else s * mu * bulk(mu)  # eqs 17, 18
+
+
+def bulk_correction(design: Design, bulk_modulus=None):
+    """A compressible rubber's correction of K = S·µ_eq, by the correspondence principle: the
+    function µ_eq ↦ S(µ_eq/K)/S (:func:`core.shape.bulk_factor`), the complex µ_eq (the loss,
+    friction's tangent included) against the elastic bulk modulus K; None for a design without
+    ``bulk_modulus`` (nearly incompressible, K = 5000 µ: S as it is). ``bulk_modulus`` (Pa, may
+    be an array broadcast against µ_eq) replaces the design's."""
+    bulk = design.material.bulk_modulus if bulk_modulus is None else bulk_modulus
+    if bulk is None:
+        return None
+    geometry, mode, kind = design.geometry, design.mode, design.shape_kind
+    return lambda mu: bulk_factor(geometry, mode, kind, mu / bulk)
 
 
 def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | str = 1,
@@ -310,7 +321,7 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
         k = wave_stiffness(mode, geo.inner_radius, geo.outer_radius, geo.length,
                            modulus(f, design.strain(x)), f, effects["wave_effects"]["density"])
     elif slices == 1:
-        k = equivalent_stiffness(modulus, s, c, f, x)
+        k = equivalent_stiffness(modulus, s, c, f, x, bulk_correction(design))
     else:
         nodes = continuum_nodes(geo, mode) if slices == "continuum" else slice_nodes(geo, mode, slices)
         fp, xp = (np.broadcast_to(v, shape).ravel() for v in (f, x))
@@ -324,75 +335,6 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
     return np.array(k)
 
 
-class PointsModel:
-    """:func:`stiffness_points` of one design at fixed points (``frequency_hz``, ``amplitude``
-    broadcast; Hz, m or rad) for many values of some of its parameters at once, ``names``
-    (fitting names, :mod:`core.registry`: a material field, or ``effect_id.name`` of an effect
-    the design carries). Called with ``values`` shaped (n, len(names)), each row one set of
-    values within the parameters' fitting ranges (ValueError otherwise), it gives K shaped
-    (n, *points): the same formulas over arrays of parameters, so the same numbers as design by
-    design. The design and the points are checked once, here (as :func:`stiffness_points` checks
-    them), not at every call: what a fit asks at every evaluation, its finite-difference
-    Jacobian's columns (one parameter changed in each) at once.
-
-    Only where the route is the single equivalent modulus (eqs 14–18, with the material-level
-    effects, inertia and standing waves): :attr:`usable` is False for slices, the continuum of
-    ``nonuniform_strain`` or an effect tied to another mode's rig (the caller then evaluates
-    design by design)."""
-
-    def __init__(self, design: Design, names: tuple[str, ...], frequency_hz, amplitude):
-        self.design, self.names = design, tuple(names)
-        self.effects = design.effect_parameters
-        self.usable = "nonuniform_strain" not in self.effects and not any("@" in n for n in self.names)
-        self.f, self.x = np.asarray(frequency_hz, float), np.asarray(amplitude, float)
-        self.shape = np.broadcast_shapes(self.f.shape, self.x.shape)
-        if self.usable:
-            check_strain(design, self.x)
-            _check_series(design, 1)
-        self.low, self.high = (np.array(b, dtype=float) for b in zip(*(parameter(n).bounds for n in self.names)))
-        self.factors = factors(design)
-        self.strain = design.strain(self.x)
-        self.terms = any(EFFECTS[e].term is not None for e in self.effects)
-        column = {name: j for j, name in enumerate(self.names)}
-        # where each material field and effect parameter comes from: a column, or the design
-        self.material = [(name, column.get(name), getattr(design.material, name)) for name in _MATERIAL_FIELDS]
-        self.params = [(eid, p, column.get(f"{eid}.{p}"), v) for eid, ps in self.effects.items() for p, v in ps.items()]
-
-    def __call__(self, values: np.ndarray) -> np.ndarray:
-        if not self.usable:
-            raise ValueError("these points of this design are computed design by design (stiffness_points)")
-        values = np.asarray(values, dtype=float)
-        n = values.shape[0]
-        inside = (values >= self.low) & (values <= self.high)
-        if not inside.all():
-            j = int(np.flatnonzero(~inside.all(axis=0))[0])
-            raise ValueError(f"{self.names[j]}: the values must lie within its fitting range "
-                             f"{self.low[j]:g} to {self.high[j]:g}")
-        by_design = values.reshape((n, len(self.names), *(1,) * len(self.shape)))  # a column: (n, 1, …)
-        material = SimpleNamespace(**{name: v if j is None else by_design[:, j] for name, j, v in self.material})
-        params: dict = {eid: {} for eid in self.effects}
-        for eid, p, j, v in self.params:
-            params[eid][p] = v if j is None else by_design[:, j]
-        if self.terms:
-            modulus = functools.partial(extended_modulus, material, params)
-        else:
-            modulus = functools.partial(mat.equivalent_modulus, material)
-        f, x = self.f, self.x
-        if "wave_effects" in self.effects:
-            geo = self.design.geometry
-            k = wave_stiffness(self.design.mode, geo.inner_radius, geo.outer_radius, geo.length,
-                               modulus(f, self.strain), f, params["wave_effects"]["density"])
-        else:
-            k = equivalent_stiffness(modulus, *self.factors, f, x)
-        if "inertia" in self.effects:
-            k = inertia_correction(k, f, params["inertia"]["mass"])
-        k = np.broadcast_to(k, (n, *self.shape))
-        if not np.isfinite(k).all():
-            raise ValueError("the stiffness is not finite at these points (check the design's effects)")
-        return np.array(k)
-
-
-_MATERIAL_FIELDS = tuple(f.name for f in dataclasses.fields(Material))
 
 
 @functools.lru_cache(maxsize=128)
@@ -465,8 +407,10 @@ def branch_stiffness(design: Design, frequency_hz, amplitude) -> dict[str, np.nd
     f = positive_values("frequency_hz", frequency_hz)[None, :]
     x = positive_values("amplitude", amplitude)[:, None]
     s, eps = design.shape_factor, design.strain(x)
-    return {name: s * modulus for name, modulus in  # eqs 17, 18 branch by branch
-            branch_moduli(design.material, design.effect_parameters, f, eps).items()}
+    moduli = branch_moduli(design.material, design.effect_parameters, f, eps)
+    bulk = bulk_correction(design)  # a compressible rubber: the whole µ_eq's factor on each branch
+    factor = 1.0 if bulk is None else bulk(sum(moduli.values()))
+    return {name: s * modulus * factor for name, modulus in moduli.items()}  # eqs 17, 18 branch by branch
 
 
 def cache_info():
@@ -483,10 +427,23 @@ STRUCTURAL_EFFECTS = ("inertia", "nonuniform_strain", "wave_effects")
 
 
 def material_model(design: Design) -> Design:
-    """``design`` without its stiffness-level effects (:data:`STRUCTURAL_EFFECTS`): the material
-    model with its material-level effects, for loops and branch-by-branch views."""
+    """``design`` without its stiffness-level effects (:data:`STRUCTURAL_EFFECTS`) and without a
+    bulk modulus (the bulk spring in series is no branch of the material): the material model
+    with its material-level effects, for loops and branch-by-branch views."""
     kept = {eid: p for eid, p in design.effect_parameters.items() if eid not in STRUCTURAL_EFFECTS}
+    if design.material.bulk_modulus is not None:
+        design = design.replace(bulk_modulus=None)
     return design if len(kept) == len(design.effects) else design.replace(effects=kept)
+
+
+def refuse_compressible(design: Design, what: str) -> None:
+    """ValueError if ``design``'s bulk modulus changes its stiffness (radial, conical, a finite
+    axial bushing): ``what`` is computed for the material's branches alone, and the bulk spring
+    in series is none of them."""
+    pure_shear = design.mode == "torsion" or (design.mode == "axial" and design.shape_kind == "long")
+    if design.material.bulk_modulus is not None and not pure_shear:
+        raise ValueError(f"material.bulk_modulus: {what} is computed from the material branches of an "
+                         f"incompressible rubber; leave bulk_modulus out for it (the stiffness honours it)")
 
 
 def refuse_structural_effects(design: Design, what: str, allowed=()) -> None:

@@ -157,10 +157,12 @@ class Design:
 
         Returns
         -------
-        float
-            Its value: m for the geometry, Pa or Pa·s^α for the moduli, dimensionless for α and ε½.
+        float or None
+            Its value: m for the geometry, Pa or Pa·s^α for the moduli, dimensionless for α and ε½;
+            None for an optional parameter left out (the bulk modulus).
         """
-        return float(getattr(getattr(self, BY_NAME[name].group), name))
+        value = getattr(getattr(self, BY_NAME[name].group), name)
+        return None if value is None else float(value)
 
     def strain(self, amplitude):
         """The equivalent strain amplitude ε_eq = c·x̂ of a drive amplitude (eqs 14, 15).

@@ -13,7 +13,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import material as mat
-from .bushing import ROUTES, Route, check_strain, positive_values, refuse_structural_effects
+from .bushing import (
+    ROUTES,
+    Route,
+    check_strain,
+    positive_values,
+    refuse_compressible,
+    refuse_structural_effects,
+)
 from .design import Design
 from .effects import branch_moduli
 from .parameters import MODE
@@ -158,6 +165,7 @@ def loop(
     if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 4:
         raise ValueError(f"points: must be a whole number ≥ 4, got {points!r}")
     refuse_structural_effects(design, "the branch-by-branch hysteresis loop")
+    refuse_compressible(design, "the branch-by-branch hysteresis loop")
     theta = 2.0 * np.pi * np.arange(points) / points
     if route == "analytic":
         forces = loop_force(design, f, xa, theta)
@@ -292,6 +300,7 @@ def force_history(design: Design, displacement, dt: float) -> HistoryResult:
     if not (np.isfinite(dt) and dt > 0):
         raise ValueError(f"dt: must be a positive finite number, got {dt!r}")
     refuse_structural_effects(design, "the force history", allowed=("inertia",))
+    refuse_compressible(design, "the force history")
     effects = design.effect_parameters
     scale = force_per_stress(design)
     br = mat.branch_stresses(design.material, design.strain(x), dt, effects)

@@ -86,6 +86,15 @@ def format_value(value, unit: str = "", quantity: str | int | None = None) -> st
     return text if not unit or unit == "–" or text == "–" else f"{text} {unit}"
 
 
+def format_change(fraction: float) -> str:
+    """A relative change as people read it: signed percent to 3 significant digits (``−1.48 %``,
+    ``+0.512 %``), ``0 %`` below 0.001 %."""
+    pct = 100.0 * float(fraction)
+    if abs(pct) < 1e-3:
+        return "0 %"
+    return ("−" if pct < 0 else "+") + format_number(abs(pct), 3) + " %"
+
+
 def link_number(value) -> str:
     """A number as a link writes it, positional (never ``1e-07``): the shortest decimal that lies
     as near the value as its rounding to :data:`LINK_DIGITS` significant digits may (half a unit

@@ -79,6 +79,7 @@ class DesignParameter:
     log: bool = True  # fitted as its logarithm (a scale) or as itself
     branch: str | None = None  # the material's: the branch of the model (eqs 1, 2, 6) it sizes or shapes
     step: float = 0.5  # the explorer's step for its field, in the display unit
+    optional: bool = False  # may be left out of a design (None): the bulk modulus
 
     @property
     def field(self) -> str:
@@ -129,10 +130,17 @@ PARAMETERS: tuple[DesignParameter, ...] = (
     DesignParameter("friction_strain_half", "material", "ε½", Unit("–", "–"), "eps_half", "Friction strain ε½",
                     "Strain ε½ at which half of σ_fmax is built: where the softening happens.",
                     "strain ε½ to build half of σ_fmax", (1e-9, 10.0), branch="friction", step=5e-4),
+    # optional: without it the rubber is nearly incompressible (K = 5000 µ, core.shape.BULK_RATIO);
+    # known by default in fits, identified only when a fit frees it (radial data are sensitive)
+    DesignParameter("bulk_modulus", "material", "K", Unit("Pa", "GPa", 1e9), "K", "Bulk modulus K",
+                    "Bulk modulus K of the rubber (filled rubber about 2 GPa); empty: nearly incompressible, "
+                    "K = 5000 µ.", "bulk modulus K", (1e7, 1e12), step=0.1, optional=True),
 )
 BY_NAME = {p.name: p for p in PARAMETERS}
 GEOMETRY = tuple(p.name for p in PARAMETERS if p.group == "geometry")
-MATERIAL = tuple(p.name for p in PARAMETERS if p.group == "material")
+# the thesis model's five, which every design has; OPTIONAL: what a design may leave out
+MATERIAL = tuple(p.name for p in PARAMETERS if p.group == "material" and not p.optional)
+OPTIONAL = tuple(p.name for p in PARAMETERS if p.optional)
 NAMES = GEOMETRY + MATERIAL
 # the material's parameters by branch of the model, in the table's order: elastic (µ),
 # fractional (m, α), friction (σ_fmax, ε½)

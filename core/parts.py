@@ -1,5 +1,6 @@
 """The bushing's parts as values: its geometry (the bonded radii and the length) and its
-compound (the five parameters of the material model), validated and immutable, in SI units.
+compound (the five parameters of the material model, and optionally its bulk modulus), validated
+and immutable, in SI units.
 
 :class:`core.design.Design` puts them together with a mode; :mod:`core.material` computes with a
 :class:`Material`. A value that breaks a rule is refused with a :class:`core.rules.DesignError`
@@ -24,6 +25,8 @@ from .rules import (
 SIZE_RANGE = (1e-6, 1e3)  # m: radii and lengths from a micrometre to a kilometre, no further
 MAX_MODULUS = 1e12  # Pa: µ, m and σ_fmax at most 1 TPa (diamond's shear modulus is about half that)
 STRAIN_HALF_RANGE = BY_NAME["friction_strain_half"].fit_range  # ε½: the range the fit searches
+# K/µ: from Poisson's ratio 0.49 (50) to 0.4999995 (10⁶); filled rubber's lies at about 700–4000
+BULK_RATIO_RANGE = (50.0, 1e6)
 
 
 @dataclass(frozen=True)
@@ -78,12 +81,17 @@ class Material:
         σ_fmax, the largest friction stress (eq 6), in Pa.
     friction_strain_half : float
         ε½, the strain at which half of σ_fmax is built (eq 6), dimensionless.
+    bulk_modulus : float or None, default None
+        K, the rubber's bulk modulus, in Pa; elastic (the rubber's volume responds without loss).
+        None: nearly incompressible, K = 5000 µ, the finite-length shape factors' own
+        (:data:`core.shape.BULK_RATIO`), the incompressible closed forms for ``shape="long"``.
 
     Raises
     ------
     DesignError
         If a value is no finite number, a modulus is not in (0, :data:`MAX_MODULUS`] (Pa), α is
-        not in (0, 1] or ε½ not in :data:`STRAIN_HALF_RANGE`; it names the key.
+        not in (0, 1] or ε½ not in :data:`STRAIN_HALF_RANGE`; it names the key (K/µ is an input
+        rule, :func:`check_bulk_ratio`).
     """
 
     shear_modulus: float
@@ -91,11 +99,14 @@ class Material:
     fractional_order: float
     friction_stress_max: float
     friction_strain_half: float
+    bulk_modulus: float | None = None
 
     def __post_init__(self):
         for f in fields(self):
             key = f"material.{f.name}"
             value = getattr(self, f.name)
+            if f.name == "bulk_modulus" and value is None:
+                continue
             if f.name == "fractional_order":
                 value = number(key, value)
                 if not 0.0 < value <= 1.0:
@@ -109,6 +120,24 @@ class Material:
             object.__setattr__(self, f.name, value)
 
 
+def check_bulk_ratio(material: Material) -> None:
+    """The input rule of the bulk modulus against the shear modulus: K/µ within
+    :data:`BULK_RATIO_RANGE` (a design file, the explorer's fields, a link). A fit may wander past
+    it while it searches (the model stays finite there); what people give may not. DesignError
+    naming ``material.bulk_modulus`` otherwise."""
+    if material.bulk_modulus is None:
+        return
+    low, high = BULK_RATIO_RANGE
+    ratio = material.bulk_modulus / material.shear_modulus
+    if not low <= ratio <= high:
+        raise DesignError(
+            "material.bulk_modulus",
+            f"must lie between {low:g} and {high:g} times the shear modulus (Poisson's ratio 0.49 to "
+            f"0.4999995; filled rubber about 2e9 Pa), got K/µ = {ratio:.3g} (K = {material.bulk_modulus!r} Pa, "
+            f"µ = {material.shear_modulus!r} Pa)", OUT_OF_RANGE)
+
+
 def as_dict(value) -> dict[str, float]:
-    """A Geometry's or a Material's fields by name (SI)."""
-    return {f.name: getattr(value, f.name) for f in fields(value)}
+    """A Geometry's or a Material's fields by name (SI); an optional field left unset (None) is
+    not among them."""
+    return {f.name: getattr(value, f.name) for f in fields(value) if getattr(value, f.name) is not None}

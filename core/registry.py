@@ -11,14 +11,14 @@ from __future__ import annotations
 
 from .design import Design
 from .effects import EFFECTS, split_id
-from .parameters import BY_NAME, MATERIAL, Parameter
+from .parameters import BY_NAME, MATERIAL, OPTIONAL, Parameter
 from .parts import as_dict
 
 
 def parameter(name: str) -> Parameter:
     """The fitting range and scale of a parameter: a material name, or ``effect_id.name``."""
     eid, _, pname = name.rpartition(".")
-    if not eid and pname in MATERIAL:
+    if not eid and (pname in MATERIAL or pname in OPTIONAL):
         return BY_NAME[pname].fitting
     base = split_id(eid)[0]
     for p in EFFECTS[base].parameters if eid and base in EFFECTS else ():

@@ -117,9 +117,11 @@ def _axial_nodes(half_length: float, h: float, wall: float, n: int) -> np.ndarra
     return np.concatenate([[0.0], np.cumsum(sizes[::-1])])
 
 
-def fe_shape_factor(a: float, b: float, L: float, mode: str, n_r: int = 6) -> tuple[float, int]:
+def fe_shape_factor(a: float, b: float, L: float, mode: str, n_r: int = 6,
+                    bulk_ratio: float = BULK_RATIO) -> tuple[float, int]:
     """S of ``mode`` from the felupe model with ``n_r`` elements across the wall (4 n_r around
-    the half circumference, graded along the length); the number of hexahedra of the quarter."""
+    the half circumference, graded along the length) and a bulk modulus ``bulk_ratio`` times the
+    shear modulus; the number of hexahedra of the quarter."""
     import felupe as fem  # the FE library (the `fe` extra): only here, for the table and its checks
 
     checked_mode(mode)
@@ -157,7 +159,7 @@ def fe_shape_factor(a: float, b: float, L: float, mode: str, n_r: int = 6) -> tu
     # µ of a rubber (1 MPa), so that the reaction forces are far above felupe's absolute floor
     # (1e-3) in its relative convergence test; S = reaction / (µ · step)
     mu = 1e6 / max(a, 1e-300) ** 2
-    solid = fem.SolidBody(fem.ThreeFieldVariation(fem.NeoHooke(mu=mu, bulk=BULK_RATIO * mu)), field)
+    solid = fem.SolidBody(fem.ThreeFieldVariation(fem.NeoHooke(mu=mu, bulk=bulk_ratio * mu)), field)
     dof0, dof1 = fem.dof.partition(field, boundaries)
     ext0 = fem.dof.apply(field, boundaries, dof0)
     # the problem is linear (a step of 1e-6 of the wall): Newton converges in one or two
@@ -184,12 +186,13 @@ class Converged:
         return abs(self.fine - self.value) / abs(self.value)
 
 
-def converged_shape_factor(a: float, b: float, L: float, mode: str, levels: tuple[int, int] = (6, 8)) -> Converged:
+def converged_shape_factor(a: float, b: float, L: float, mode: str, levels: tuple[int, int] = (6, 8),
+                           bulk_ratio: float = BULK_RATIO) -> Converged:
     """S from two meshes (``levels`` elements across the wall) and Richardson's extrapolation
-    with the observed order 2 (checked on three meshes in the tests)."""
+    with the observed order 2 (checked on three meshes in the tests), at K/µ ``bulk_ratio``."""
     n1, n2 = levels
-    s1, _ = fe_shape_factor(a, b, L, mode, n1)
-    s2, cells = fe_shape_factor(a, b, L, mode, n2)
+    s1, _ = fe_shape_factor(a, b, L, mode, n1, bulk_ratio)
+    s2, cells = fe_shape_factor(a, b, L, mode, n2, bulk_ratio)
     w = (1 / n2**2) / (1 / n1**2 - 1 / n2**2)
     return Converged(s2 - w * (s1 - s2), s1, s2, cells)
 
@@ -203,6 +206,7 @@ class ShapeTable:
     length_ratio: np.ndarray  # L/(b − a)
     ratios: dict  # mode → array (radius_ratio × length_ratio) of S_FE / S_reference
     splines: dict = field(default_factory=dict)  # mode → bicubic spline of ln(ratio) in the logarithms
+    slopes: dict = field(default_factory=dict)  # mode → bicubic spline of the series law's slope g
 
     def ratio(self, mode: str, radius_ratio: float, length_ratio: float) -> float:
         lo_r, hi_r = self.radius_ratio[[0, -1]]
@@ -215,6 +219,16 @@ class ShapeTable:
         # the spline interpolates ln(ratio): its exp stays positive and smooth
         return math.exp(float(self.splines[mode](math.log(radius_ratio), math.log(length_ratio))[0, 0]))
 
+    def slope(self, mode: str, radius_ratio: float, length_ratio: float) -> float:
+        """The series law's slope g at (b/a, L/(b − a)) inside the table (:meth:`ratio`'s range)."""
+        self.ratio(mode, radius_ratio, length_ratio)  # the range check and its message
+        return float(self.slopes[mode](math.log(radius_ratio), math.log(length_ratio))[0, 0])
+
+    def compressible_factor(self, mode: str, radius_ratio: float, length_ratio: float, x):
+        """S(x)/S(x₀) of the table's FE model at µ/K = ``x`` (real, or complex for a complex
+        shear modulus), x₀ = 1/:data:`BULK_RATIO`: 1/(1 + g·(x − x₀))."""
+        return 1.0 / (1.0 + self.slope(mode, radius_ratio, length_ratio) * (x - 1.0 / BULK_RATIO))
+
 
 @functools.cache
 def table() -> ShapeTable:
@@ -225,7 +239,9 @@ def table() -> ShapeTable:
     q, lam = np.array(data["radius_ratio"]), np.array(data["length_ratio"])
     ratios = {m: np.array(v) for m, v in data["ratios"].items()}
     splines = {m: RectBivariateSpline(np.log(q), np.log(lam), np.log(r), kx=3, ky=3, s=0) for m, r in ratios.items()}
-    return ShapeTable(q, lam, ratios, splines)
+    slopes = {m: RectBivariateSpline(np.log(q), np.log(lam), np.array(g), kx=3, ky=3, s=0)
+              for m, g in data.get("compressibility", {}).get("slopes", {}).items()}
+    return ShapeTable(q, lam, ratios, splines, slopes)
 
 
 def finite_shape_factor(a: float, b: float, L: float, mode: str) -> float:
@@ -270,6 +286,42 @@ def shape_factor(geometry: Geometry, mode: str, shape: str | None = None) -> flo
     if (shape or checked_mode(mode).default_shape) == "finite":
         return finite_shape_factor(a, b, L, mode)
     return long_shape_factor(a, b, L, mode)
+
+
+def long_radial_compressible(a: float, b: float, L: float, x):
+    """The long radial shape factor (plane strain) of a compressible rubber, µ/K = ``x`` (real,
+    or complex by the correspondence principle):
+
+        S = 8πL (1 − ν) / ((3 − 4ν) ln(b/a) − (b² − a²) / ((3 − 4ν)(b² + a²))),
+
+    with Poisson's ratio ν = (3 − 2x) / (2(3 + x)): the exact solution of Navier's equations for
+    the inner tube displaced across the axis (the displacement's first circular harmonic; four
+    constants from the bonded tubes). At x = 0 it is the incompressible closed form; for a thin
+    wall t = b − a it tends to πa(λ + 3µ)/t per length (compression λ + 2µ and shear µ of the
+    layer)."""
+    a, b, L = _radii(a, b, L)
+    nu = (3.0 - 2.0 * x) / (2.0 * (3.0 + x))
+    k = 3.0 - 4.0 * nu
+    return 8.0 * math.pi * L * (1.0 - nu) / (k * math.log(b / a) - (b * b - a * a) / (k * (b * b + a * a)))
+
+
+def bulk_factor(geometry: Geometry, mode: str, shape: str | None, x):
+    """How much a bulk modulus K changes the shape factor: S(µ/K = x) / S, with S the shape
+    factor of :func:`shape_factor` (K/µ = :data:`BULK_RATIO` for the finite-length table, the
+    incompressible closed forms for ``long``). ``x`` is µ/K, real or complex (µ* complex: the
+    correspondence principle, K* = µ*·S(µ*/K)); an array broadcasts.
+
+    Torsion and the long axial bushing are pure shear (factor 1 at any K). The finite-length
+    table's entries follow the series law 1/S(x) = (1 + g·(x − x₀))/S(x₀), a shear spring in
+    series with a bulk spring (its slope g from a second FE solve); the long radial bushing has
+    the plane-strain closed form :func:`long_radial_compressible`."""
+    a, b, L = _radii(geometry.inner_radius, geometry.outer_radius, geometry.length)
+    kind = shape or checked_mode(mode).default_shape
+    if mode == "torsion" or (mode == "axial" and kind == "long"):
+        return np.ones_like(np.asarray(x) * 1.0)
+    if kind == "long":  # radial
+        return long_radial_compressible(a, b, L, x) / long_shape_factor(a, b, L, "radial")
+    return table().compressible_factor(mode, b / a, L / (b - a), np.asarray(x))
 
 
 def strain_factor(geometry: Geometry, mode: str, shape: str | None = None) -> float:

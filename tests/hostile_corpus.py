@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from core.parameters import MATERIAL
 from tests.hostile_cases import (
     BAD_NUMBERS,
     DESIGN,
@@ -73,7 +74,11 @@ DESIGN_RULES = {**dict.fromkeys(DESIGN["geometry"], _within(1e-6, 1e3, "between"
                 **dict.fromkeys(("shear_modulus", "fractional_coefficient", "friction_stress_max"),
                                 _within(0, 1e12, "at most")),
                 "fractional_order": lambda v: None if 0 < v <= 1 else "(0, 1]",
-                "friction_strain_half": _within(1e-9, 10.0, "between")}
+                "friction_strain_half": _within(1e-9, 10.0, "between"),
+                # K: positive, at most 1 TPa, and 50 to 10⁶ times µ
+                "bulk_modulus": lambda v: ("positive" if v <= 0 else "at most" if v > 1e12 else
+                                           None if 50 <= v / DESIGN["material"]["shear_modulus"] <= 1e6
+                                           else "times the shear modulus")}
 
 
 def design_cases(folder: Path, files: dict, good: Path) -> list[Case]:
@@ -86,6 +91,11 @@ def design_cases(folder: Path, files: dict, good: Path) -> list[Case]:
                 text = json.dumps(DESIGN).replace(f'"{key}": {json.dumps(DESIGN[section][key])}', f'"{key}": {bad}')
                 rule = _number_rule(f"{section}.{key}", bad, DESIGN_RULES[key])
                 texts[f"{section}.{key} = {bad[:20]}"] = (text, rule)
+    with_bulk = {**DESIGN, "material": {**DESIGN["material"], "bulk_modulus": 2.0e9}}  # the optional K
+    for bad in BAD_NUMBERS:
+        text = json.dumps(with_bulk).replace('"bulk_modulus": 2000000000.0', f'"bulk_modulus": {bad}')
+        texts[f"material.bulk_modulus = {bad[:20]}"] = (
+            text, _number_rule("material.bulk_modulus", bad, DESIGN_RULES["bulk_modulus"]))
     for eid, pname in EFFECT_CASES:
         for bad in BAD_NUMBERS[:10]:
             words = _number_rule(f"effects.{eid}.{pname}", bad, lambda v: "≥ 0" if v < 0 else None)
@@ -429,7 +439,7 @@ def whatif_cases(folder: Path, files: dict, design: Path) -> list[Case]:
             {"ratio": ["axial", "axial"], "frequency_hz": 10, "amplitude": 1e-4, "magnitude": 2}]}),
             ("targets[0].ratio", "two different modes")),
         "targets: every material free": ("targets", json.dumps({**TARGETS, "free_material": {
-            n: {"min": 1e-30, "max": 1e30} for n in DESIGN["material"]}}), Accepted("design")),
+            n: {"min": 1e-30, "max": 1e30} for n in DESIGN["material"] if n in MATERIAL}}), Accepted("design")),
         "tolerance: 5000 samples on a big grid": ("tolerance", json.dumps({**TOLERANCES, "samples": 5000}),
                                                   ("samples", "20000000")),
         "tolerance: 89 % of b": ("tolerance", json.dumps({"tolerances": {"outer_radius": "89%"}}),

@@ -12,17 +12,18 @@ from app.bands import parse_tolerances
 from app.link import URL_NAMES
 from app.state import ExplorerState
 from core import Design, Geometry, Material
+from core.parameters import OPTIONAL
 from core.whatif.tolerance import ToleranceError
 
 ROOT = Path(__file__).resolve().parents[1]
-PREFIXES = {"": 1.0, "m": 1e-3, "k": 1e3, "M": 1e6}  # the SI prefixes of the units shown
+PREFIXES = {"": 1.0, "m": 1e-3, "k": 1e3, "M": 1e6, "G": 1e9}  # the SI prefixes of the units shown
 DESIGN_NAMES = tuple(f.name for f in fields(Geometry)) + tuple(f.name for f in fields(Material))
 # the keys of a link as people have shared them (tests/ui opens such links): key → state parameter
 SHARED = {"mode": "mode", "finite": "finite_length", "a_mm": "inner_radius_mm", "b_mm": "outer_radius_mm",
           "L_mm": "length_mm", "mu_MPa": "shear_modulus_mpa", "m_MPa": "fractional_coefficient_mpa",
           "alpha": "fractional_order", "sigma_kPa": "friction_stress_max_kpa", "eps_half": "friction_strain_half",
           "amp": "amplitude", "f_Hz": "frequency_hz", "fmin_Hz": "freq_min", "fmax_Hz": "freq_max",
-          "tol": "tolerance_text", "bands": "band_on"}
+          "K_GPa": "bulk_modulus_gpa", "tol": "tolerance_text", "bands": "band_on"}
 
 
 def text(path: str) -> str:
@@ -46,12 +47,14 @@ def documented_display_units() -> dict[str, str]:
     for part in re.search(r"the five material parameters \(([^)]*)\)", readme).group(1).split(", "):
         shown, unit = re.fullmatch(r"(.+?) (?:in (\S+)|plain)", part).groups()
         out.update({symbol: unit or "–" for symbol in shown.split(" and ")})
+    for symbol, unit in re.findall(r"the bulk modulus (\S+) in (\S+) \(optional", readme):
+        out[symbol] = unit
     return out
 
 
 def test_each_design_field_shows_its_documented_parameter_in_its_documented_unit():
     symbols, shown = documented_symbols(), documented_display_units()
-    assert set(shown) == {symbols[n][0] for n in DESIGN_NAMES}  # the README names all eight
+    assert set(shown) == {symbols[n][0] for n in DESIGN_NAMES}  # the README names all nine
     for name in DESIGN_NAMES:
         symbol, si = symbols[name]
         state = ExplorerState()
@@ -61,7 +64,10 @@ def test_each_design_field_shows_its_documented_parameter_in_its_documented_unit
         assert unit.split("·")[0] == shown[symbol], (field, unit)  # MPa·s^α is shown "in MPa"
         prefix = "" if si == "–" else unit.removesuffix(si)  # mm: m × 1e-3; MPa·s^α: Pa·s^α × 1e6
         assert prefix in PREFIXES and prefix + si == unit, (field, unit, si)  # a plain number: "–" both
-        value = 1.1 * getattr(state, field)  # a valid design still (b stays above a)
+        shown_value = getattr(state, field)
+        if shown_value is None:  # an optional field, empty at first: a value it takes (K = 1000 µ)
+            shown_value = 1000 * state.design.material.shear_modulus / PREFIXES[prefix] / 1.1
+        value = 1.1 * shown_value  # a valid design still (b stays above a)
         setattr(state, field, value)
         assert state.errors == {}
         group = state.design.geometry if name in DESIGN_NAMES[:3] else state.design.material
@@ -77,7 +83,8 @@ def test_the_links_tolerance_keys_are_those_docs_files_md_lists():
     meant = {by_symbol[symbol]: float(pct) for symbol, pct in re.findall(r"(\S+) ±(\S+) %", said)}
     assert parse_tolerances(tol) == meant  # mu:10,L:1 is µ ±10 %, L ±1 %
     every = parse_tolerances(",".join(f"{key}:1" for key in keys))
-    assert sorted(every) == sorted(DESIGN_NAMES)  # one key per design parameter, none left out
+    # one key per design parameter every design has, none left out (not the optional bulk modulus)
+    assert sorted(every) == sorted(n for n in DESIGN_NAMES if n not in OPTIONAL)
     for wrong in ("mu_MPa:1", "mu:90", "mu:1,mu:2"):
         with pytest.raises(ToleranceError, match=", ".join(keys)):
             parse_tolerances(wrong)

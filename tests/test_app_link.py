@@ -57,7 +57,8 @@ def test_a_link_with_bad_values_applies_the_good_ones_and_says_which(session):
     assert s.errors["amplitude"].startswith("The link's amp=-5.0 is outside this bushing's amplitude axis (")
     assert s.errors["shear_modulus_mpa"] == "The link's mu_MPa='abc' is not a number; kept 2.42."
     flush(session)
-    assert set(url()) == set(URL_NAMES.values())  # the whole session is in the address bar
+    # the whole session is in the address bar (an optional field left empty: its key left out)
+    assert set(url()) == set(URL_NAMES.values()) - {"K_GPa"}
     assert (url()["b_mm"], url()["f_Hz"], url()["tol"], url()["bands"]) == ("40", "20", "mu:10", "true")
 
 
@@ -116,6 +117,26 @@ def test_a_link_holds_the_effects_the_name_and_the_reference(session):
     assert again.design == diagnosed and again.errors == {}
     ref, want = again.reference.to_dict(), s.reference.to_dict()
     assert ref["effects"] == want["effects"] and ref["geometry"] == pytest.approx(want["geometry"], rel=1e-12)
+
+
+def test_a_link_holds_the_bulk_modulus_and_an_empty_field_is_the_incompressible_rubber(session):
+    """The optional bulk modulus: set, it is in the link (K_GPa) and the link opens it again;
+    emptied, the design has none and the link no key; K/µ outside 50–1e6 is refused beside it."""
+    app = opened("?mode=radial")
+    s = app.state
+    s.bulk_modulus_gpa = 2.0
+    assert s.errors == {} and s.design.material.bulk_modulus == pytest.approx(2.0e9, rel=1e-12)
+    flush(session)
+    assert url()["K_GPa"] == "2"
+    link = pn.state.location.search
+    pn.state.curdoc = Document()
+    again = opened(link).state
+    assert again.design == s.design
+    again.bulk_modulus_gpa = None
+    assert again.errors == {} and again.design.material.bulk_modulus is None
+    again.bulk_modulus_gpa = 0.01  # K/µ = 4: far too compressible for rubber
+    assert "between 50 and 1e+06 times the shear modulus" in again.errors["bulk_modulus_gpa"]
+    assert again.design.material.bulk_modulus is None  # the plots keep the last valid design
 
 
 def test_a_links_bad_effect_or_amplitude_is_refused_with_its_rule(session):

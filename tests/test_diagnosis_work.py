@@ -17,7 +17,7 @@ from core.identify.uncertainty import CROSSING_TOLERANCE, profile
 from core.synthetic import synthetic_stiffness
 
 # the model evaluations of the 150-point diagnosis's fits (calls of stiffness_points, and the
-# parameter sets of each call of core.bushing.PointsModel, a finite-difference Jacobian's columns
+# parameter sets of each call of core.points.PointsModel, a finite-difference Jacobian's columns
 # at once): 10,563 before the profile's crossings were interpolated (the final profile 3,242 of
 # them), 9,605 after (2,284); 6,315 once a start that joins an earlier start's path stops there
 # (the viscous candidate's three starts crept side by side, 3,476 evaluations; 1,295 now), 6,004
@@ -111,9 +111,10 @@ def test_the_profile_crossing_is_where_a_fine_search_puts_it():
                                      {"rate_amplitude_coupling": {"rate_exponent": 0.1}},
                                      {"wave_effects": {"density": 1100.0}}])
 def test_the_model_of_many_parameter_sets_at_once_gives_each_design_s_own_numbers(effects):
-    """core.bushing.PointsModel (a Jacobian's columns in one pass) against stiffness_points of each
+    """core.points.PointsModel (a Jacobian's columns in one pass) against stiffness_points of each
     design alone: the same numbers, bit for bit; values outside a fitting range refused."""
-    from core.bushing import PointsModel, stiffness_points
+    from core.bushing import stiffness_points
+    from core.points import PointsModel
     from core.registry import parameter, parameter_values, with_values
 
     design = PAPER_B.replace(effects=effects)

@@ -20,6 +20,7 @@ from core.parameters import (
     MODE_TABLE,
     MODES,
     NAMES,
+    OPTIONAL,
     PARAMETERS,
 )
 from core.parts import Geometry, Material, as_dict
@@ -43,7 +44,7 @@ def _design_parameter_rows() -> dict[str, list[str]]:
 
 def test_the_model_page_shows_every_design_parameter_as_the_table_has_it():
     rows = _design_parameter_rows()
-    assert list(rows) == list(NAMES)  # none the page lacks, none the table lacks, in the same order
+    assert list(rows) == [p.name for p in PARAMETERS]  # none the page lacks, none the table lacks, in order
     for name, (symbol, _, si, shown, factor, link, meaning) in rows.items():
         p = BY_NAME[name]
         assert (symbol, si, shown, link.strip("`"), meaning) == (p.symbol, p.unit.si, p.unit.display, p.url_key,
@@ -57,7 +58,8 @@ def test_the_link_keys_are_those_the_files_page_documents():
     text = (DOCS / "files.md").read_text(encoding="utf-8")
     listed = re.search(r"`tol=[^`]*`[^)]*?keys ((?:`[^`]+`,\s*)+)percents", text)
     assert listed, "docs/files.md no longer lists the tolerances' keys of a link"
-    assert re.findall(r"`([^`]+)`", listed.group(1)) == [p.tolerance_key for p in PARAMETERS]
+    # the parameters with tolerances: every design's (not the optional bulk modulus)
+    assert re.findall(r"`([^`]+)`", listed.group(1)) == [BY_NAME[n].tolerance_key for n in NAMES]
     rows = _design_parameter_rows()
     assert len(rows) == len(PARAMETERS)
     for name, cells in rows.items():
@@ -67,7 +69,7 @@ def test_the_link_keys_are_those_the_files_page_documents():
 
 # ---- units: SI prefixes and dimensions ----------------------------------------------------------
 
-PREFIXES = {"": 1.0, "k": 1e3, "M": 1e6, "m": 1e-3}
+PREFIXES = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9, "m": 1e-3}
 
 
 def _prefix_factor(display: str, si: str) -> float:
@@ -133,7 +135,8 @@ def test_the_reference_designs_lie_inside_every_fitting_range():
 
 def test_the_design_file_keys_are_the_tables_in_its_order():
     assert tuple(f.name for f in fields(Geometry)) == GEOMETRY
-    assert tuple(f.name for f in fields(Material)) == MATERIAL
+    assert tuple(f.name for f in fields(Material)) == MATERIAL + OPTIONAL
+    assert all(f.default is None for f in fields(Material) if f.name in OPTIONAL)
     assert all(BY_NAME[n].fit_range is None for n in GEOMETRY)
     assert all(BY_NAME[n].fit_range is not None for n in MATERIAL)
 

@@ -16,6 +16,7 @@ from core.identify.fit import fit_global
 from core.identify.uncertainty import profile
 from core.io.design_file import read_design
 from core.io.measured import read_stiffness
+from core.parts import as_dict
 from core.registry import parameter_values
 from core.synthetic import synthetic_stiffness
 
@@ -103,7 +104,7 @@ def test_a_fit_driven_to_its_bounds_says_so():
     design = read_design(EXAMPLES / "table1_guess.json")
     result = fit_global(design, read_stiffness(EXAMPLES / "paper_b_stiffness.csv"))
     assert any("ran to the" in w and "mode" in w for w in result.warnings), result.warnings
-    assert all(math.isfinite(v) for v in result.design.material.__dict__.values())
+    assert all(math.isfinite(v) for v in as_dict(result.design.material).values())
 
 
 def test_the_diagnosis_inherits_the_profile():

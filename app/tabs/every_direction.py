@@ -7,9 +7,9 @@ from __future__ import annotations
 import panel as pn
 import param
 
-from core.card import CARD_MODES, card, ratios
-from core.numbers import format_number, format_value
-from core.parameters import MODE, ROTATIONS, TRANSLATIONS
+from core.card import CARD_MODES, against_incompressible, card, ratios
+from core.numbers import format_change, format_number, format_value
+from core.parameters import BY_NAME, MODE, ROTATIONS, TRANSLATIONS
 from core.shape import long_shape_factor
 
 from .. import units
@@ -94,10 +94,11 @@ class CardView(PlotView):
     @staticmethod
     def summary(design, frequency_hz, rows) -> str:
         g = design.geometry
+        bulk = against_incompressible(design, frequency_hz, rows)
         lines = [f"**At {format_value(frequency_hz, 'Hz', 'frequency')}** ({design.name or 'this design'})", "",
                  ("| direction | amplitude | \\|K\\| | loss factor | shape factor used | S "
-                 "| S / long-bushing formula |"),
-                 "|---|---|---|---|---|---|---|"]
+                 "| S / long-bushing formula | \\|K\\|, loss factor against an incompressible rubber |"),
+                 "|---|---|---|---|---|---|---|---|"]
         for r in rows:
             mode = r["mode"]
             amp = units.display_amplitude(r["amplitude"], mode)
@@ -109,7 +110,15 @@ class CardView(PlotView):
                 versus = "no formula"
             lines.append(f"| {mode} | {format_value(amp, units.amplitude_unit(mode), 'amplitude')} "
                          f"| {format_number(k, 'stiffness')} {units.stiffness_unit(mode)} | {r['loss_factor']:.4f} "
-                         f"| {shape_used(design, mode)} | {format_value(r['shape_factor'], s_unit)} | {versus} |")
+                         f"| {shape_used(design, mode)} | {format_value(r['shape_factor'], s_unit)} | {versus} "
+                         f"| {format_change(bulk[mode][0])}, {format_change(bulk[mode][1])} |")
+        k = design.material.bulk_modulus
+        unit = BY_NAME["bulk_modulus"].unit
+        lines += ["", (f"**Compressibility**: bulk modulus K = {format_value(unit.to_display(k), unit.display, 'parameter')} (K/µ "
+                       f"{format_number(k / design.material.shear_modulus, 3)})" if k is not None else
+                       "**Compressibility**: no bulk modulus given: a nearly incompressible rubber, K = 5000 µ")
+                  + "; the last column compares each direction with the same bushing of an incompressible rubber "
+                    "(torsion and the long axial formula are pure shear; thin walls squeezed radially care most)."]
         q = ratios(design, rows)
         lines += ["", (f"**Ratios**: radial / axial **{q['radial/axial']:.2f}**; radial / torsion-equivalent "
                        f"(K_torsion / r_m², r_m = (a + b)/2) **{q['radial/torsion-equivalent']:.2f}**.")]

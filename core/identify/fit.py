@@ -31,12 +31,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..bushing import PointsModel, check_measured_amplitude, stiffness_points
+from ..bushing import check_measured_amplitude, refuse_compressible, stiffness_points
 from ..data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from ..design import Design
 from ..loops import loop_force
 from ..parameters import BRANCH_PARAMETERS, MATERIAL
 from ..parts import as_dict
+from ..points import PointsModel
 from ..registry import parameter, parameter_values, with_values
 from ..residuals import gap, gaps_by_mode, relative_residual
 from ..rules import decimal
@@ -223,7 +224,7 @@ class _Problem:
 
     def residuals_many(self, thetas: list[np.ndarray]) -> list[np.ndarray]:
         """:meth:`residuals` at each of ``thetas``, the same numbers: the model at every point in
-        one evaluation (:class:`core.bushing.PointsModel`) where it allows (stiffness data of one
+        one evaluation (:class:`core.points.PointsModel`) where it allows (stiffness data of one
         mode, no loop), else point by point. What a finite-difference Jacobian asks."""
         if self._points() is None:
             return [self._residuals(t) for t in thetas]
@@ -384,6 +385,7 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     if data is not None:
         check_data_amplitudes(design, data)  # the measured amplitudes, for this bushing
     if loop is not None:
+        refuse_compressible(design, "a fit to a measured loop")
         check_measured_amplitude(design, loop.harmonic()[1], "the loop's amplitude")
         loop.check_force()  # after the amplitude: a displacement in wrong units is named as such
     n = (0 if data is None else 2 * len(data)) + (0 if loop is None else loop.force.size)

@@ -12,8 +12,8 @@ from pathlib import Path
 from typing import Any
 
 from ..design import Design
-from ..parameters import GEOMETRY, MATERIAL, MODES
-from ..parts import Geometry, Material
+from ..parameters import GEOMETRY, MATERIAL, MODES, OPTIONAL
+from ..parts import Geometry, Material, check_bulk_ratio
 from ..rules import (
     BAD_CHOICE,
     BAD_TYPE,
@@ -56,15 +56,21 @@ def design_from_dict(data: Any) -> Design:
     """Build a :class:`Design` from a design-file object (docs/files.md), refusing anything off."""
     _exact_keys("", data, _TOP_KEYS, ("mode", "geometry", "material"))
     _exact_keys("geometry", data["geometry"], GEOMETRY, GEOMETRY)
-    _exact_keys("material", data["material"], MATERIAL, MATERIAL)
+    _exact_keys("material", data["material"], MATERIAL + OPTIONAL, MATERIAL)
+    for key in OPTIONAL:
+        if key in data["material"] and data["material"][key] is None:
+            raise DesignError(f"material.{key}", "must be a number (leave the key out for a nearly incompressible "
+                              "rubber, K = 5000 µ)", BAD_TYPE)
     if "fit" in data and not isinstance(data["fit"], Mapping):  # a fitted file's report: kept aside
         raise DesignError("fit", "must be an object (the report of `bushing fit`)", BAD_TYPE)
     if not isinstance(data["mode"], str):
         raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {data['mode']!r}", BAD_CHOICE)
+    material = Material(**data["material"])
+    check_bulk_ratio(material)
     return Design(
         mode=data["mode"],
         geometry=Geometry(**data["geometry"]),
-        material=Material(**data["material"]),
+        material=material,
         name=data.get("name"),
         effects=data.get("effects", {}),
         shape=data.get("shape"),

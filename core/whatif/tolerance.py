@@ -30,6 +30,7 @@ import numpy as np
 from scipy import linalg, stats
 
 from ..bushing import (
+    bulk_correction,
     check_strain,
     equivalent_stiffness,
     factors,
@@ -318,6 +319,9 @@ def _closed_form_samples(design: Design, draws: list[dict[str, float]], f, x, sh
     one whose strain :func:`core.bushing.check_strain` refuses."""
     if design.effects or slices != 1 or route != "analytic":
         return None
+    geometry_varies = any(name in draws[0] for name in GEOMETRY) if draws else False
+    if geometry_varies and design.material.bulk_modulus is not None:
+        return None  # the bulk modulus's factor depends on each sample's geometry: design by design
     n, ones = len(draws), (1,) * len(shape)
 
     def column(name: str) -> np.ndarray:
@@ -325,7 +329,6 @@ def _closed_form_samples(design: Design, draws: list[dict[str, float]], f, x, sh
             return np.array([d[name] for d in draws]).reshape((n, *ones))
         return np.full((n, *ones), design.value(name))
 
-    geometry_varies = any(name in draws[0] for name in GEOMETRY) if draws else False
     if geometry_varies:
         s, c = _sample_factors(design.mode, design.shape, tuple(
             tuple(d.get(name, design.value(name)) for name in GEOMETRY) for d in draws))
@@ -341,8 +344,8 @@ def _closed_form_samples(design: Design, draws: list[dict[str, float]], f, x, sh
         s, c = factors(design)
     # Material's fields, each one value per sample: equivalent_modulus broadcasts over them
     material = SimpleNamespace(**{name: column(name) for name in MATERIAL})
-    k = np.broadcast_to(equivalent_stiffness(functools.partial(equivalent_modulus, material), s, c, f, x),
-                        (n, *shape))
+    k = np.broadcast_to(equivalent_stiffness(functools.partial(equivalent_modulus, material), s, c, f, x,
+                                             bulk_correction(design)), (n, *shape))
     if not np.all(np.isfinite(k)):
         raise ValueError("the stiffness of a sample is not finite")
     return np.array(k)
