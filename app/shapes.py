@@ -11,7 +11,8 @@ with :func:`shape_phrase`.
 from __future__ import annotations
 
 from core import Design
-from core.parameters import MODE, THESIS_MODES
+from core.numbers import format_value
+from core.parameters import BY_NAME, MODE, THESIS_MODES
 
 
 def card_basis(design: Design) -> Design:
@@ -40,7 +41,12 @@ def shape_phrase(design: Design, modes: tuple[str, ...] | None = None) -> str:
     """The one sentence each view shows: "Shape factor: …" for ``design``'s own mode, or for
     each of ``modes`` (those with the same kind of shape factor named together)."""
     if modes is None:
-        return f"Shape factor: {shape_used(design)}."
+        k = design.material.bulk_modulus
+        pure_shear = design.mode == "torsion" or (design.mode == "axial" and design.shape_kind == "long")
+        bulk = "" if k is None or pure_shear else (
+            f" Bulk modulus K = {format_value(BY_NAME['bulk_modulus'].unit.to_display(k), 'GPa', 'parameter')}: "
+            "|K| and the loss factor include it; the loop and the branches are the material's (incompressible).")
+        return f"Shape factor: {shape_used(design)}.{bulk}"
     long = [m for m in modes if shape_used(design, m) != "finite-length table"]
     finite = [m for m in modes if m not in long]
     if not long:

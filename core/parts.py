@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 
+from .numbers import format_number
 from .parameters import BY_NAME
 from .rules import (
     ORDER_RANGE,
@@ -130,11 +131,14 @@ def check_bulk_ratio(material: Material) -> None:
     low, high = BULK_RATIO_RANGE
     ratio = material.bulk_modulus / material.shear_modulus
     if not low <= ratio <= high:
+        k, mu = BY_NAME["bulk_modulus"].unit, BY_NAME["shear_modulus"].unit
+        shown = lambda value, unit: f"{format_number(unit.to_display(value), 3)} {unit.display}"
         raise DesignError(
             "material.bulk_modulus",
-            f"must lie between {low:g} and {high:g} times the shear modulus (Poisson's ratio 0.49 to "
-            f"0.4999995; filled rubber about 2e9 Pa), got K/µ = {ratio:.3g} (K = {material.bulk_modulus!r} Pa, "
-            f"µ = {material.shear_modulus!r} Pa)", OUT_OF_RANGE)
+            f"must lie between {low:g} and {format_number(high)} times the shear modulus (Poisson's ratio 0.49 to "
+            f"0.4999995; filled rubber has about 2 GPa): with µ = {shown(material.shear_modulus, mu)}, "
+            f"{shown(low * material.shear_modulus, k)} to {shown(high * material.shear_modulus, k)}; got "
+            f"{shown(material.bulk_modulus, k)} (K/µ = {format_number(ratio, 3)})", OUT_OF_RANGE)
 
 
 def as_dict(value) -> dict[str, float]:
