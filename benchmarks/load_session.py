@@ -36,6 +36,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from app_latency import cpu_seconds  # noqa: F401 (the load client's too)
+
 ROOT = HERE.parent
 NGINX = shutil.which("nginx") or ("/usr/sbin/nginx" if Path("/usr/sbin/nginx").exists() else None)
 SLIDER = "Drive amplitude"
@@ -107,16 +110,6 @@ def start_nginx(backends: list[int], workdir: Path) -> tuple[subprocess.Popen, i
 
 def port_of(url: str) -> int:
     return int(re.search(r":(\d+)/", url).group(1))
-
-
-def cpu_seconds(pid: int) -> float:
-    """User + system CPU time of process ``pid`` so far, every thread (``/proc/PID/stat``), in s."""
-    try:
-        with open(f"/proc/{pid}/stat") as f:
-            fields = f.read().rsplit(")", 1)[1].split()
-    except OSError:
-        return 0.0
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def rss_mb(pid: int) -> float:
