@@ -171,19 +171,21 @@ def _install_request():
     connection.HTTPRequest = Request
 
 
+# the modules of panel.models the explorer's and the floors' documents need beyond the package
+# itself: not every module, whose models would bring external scripts (KaTeX, deck.gl …) into
+# every page the same process serves afterwards (the test suite's own explorer)
+PANEL_MODULES = ("panel.models.file_dropper",)
+
+
 def _import_panel_models():
-    """``panel.models`` and each of its modules (some, such as the file dropper, are imported
-    only by the widget that uses them), so the client's document can hold every Panel model."""
+    """``panel.models`` and :data:`PANEL_MODULES` (imported only by the widget that uses them), so
+    the client's document can hold every Panel model of these pages."""
     import importlib
-    import pkgutil
 
-    import panel.models
+    import panel.models  # noqa: F401
 
-    for info in pkgutil.iter_modules(panel.models.__path__, "panel.models."):
-        try:
-            importlib.import_module(info.name)
-        except Exception:  # noqa: BLE001, S112 - a model whose optional library is missing: not on these pages
-            continue
+    for name in PANEL_MODULES:
+        importlib.import_module(name)
 
 
 def plot_data(message, sources: set[str]) -> bool:
