@@ -13,6 +13,7 @@ from __future__ import annotations
 from core import Design
 from core.numbers import format_value
 from core.parameters import BY_NAME, MODE, THESIS_MODES
+from core.shape import pure_shear
 
 
 def card_basis(design: Design) -> Design:
@@ -42,8 +43,7 @@ def shape_phrase(design: Design, modes: tuple[str, ...] | None = None) -> str:
     each of ``modes`` (those with the same kind of shape factor named together)."""
     if modes is None:
         k = design.material.bulk_modulus
-        pure_shear = design.mode == "torsion" or (design.mode == "axial" and design.shape_kind == "long")
-        bulk = "" if k is None or pure_shear else (
+        bulk = "" if k is None or pure_shear(design.mode, design.shape_kind) else (
             f" Bulk modulus K = {format_value(BY_NAME['bulk_modulus'].unit.to_display(k), 'GPa', 'parameter')}: "
             "|K| and the loss factor include it; the loop and the branches are the material's (incompressible).")
         return f"Shape factor: {shape_used(design)}.{bulk}"

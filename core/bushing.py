@@ -27,7 +27,7 @@ from .design import Design
 from .effects import EFFECTS, branch_moduli, extended_modulus, inertia_correction, wave_stiffness
 from .parameters import MODE, THESIS_MODES
 from .response import ComplexStiffness, loss_factor
-from .shape import bulk_factor, shape_factor, strain_factor  # noqa: F401 (re-exported)
+from .shape import bulk_factor, pure_shear, shape_factor, strain_factor  # noqa: F401 (re-exported)
 from .slices import continuum_node_count, continuum_nodes, slice_nodes, solve_series
 
 Route = Literal["analytic", "time-domain"]
@@ -252,11 +252,12 @@ def bulk_correction(design: Design, bulk_modulus=None):
     """A compressible rubber's correction of K = S·µ_eq, by the correspondence principle: the
     function µ_eq ↦ S(µ_eq/K)/S (:func:`core.shape.bulk_factor`), the complex µ_eq (the loss,
     friction's tangent included) against the elastic bulk modulus K; None for a design without
-    ``bulk_modulus`` (nearly incompressible, K = 5000 µ: S as it is). ``bulk_modulus`` (Pa, may
+    ``bulk_modulus`` (nearly incompressible, K = 5000 µ: S as it is) or in a direction of pure shear
+    (:func:`core.shape.pure_shear`). ``bulk_modulus`` (Pa, may
     be an array broadcast against µ_eq) replaces the design's."""
     bulk = design.material.bulk_modulus if bulk_modulus is None else bulk_modulus
-    if bulk is None:
-        return None
+    if bulk is None or pure_shear(design.mode, design.shape_kind):
+        return None  # nothing to correct: K absent, or a direction that only shears the rubber
     geometry, mode, kind = design.geometry, design.mode, design.shape_kind
     return lambda mu: bulk_factor(geometry, mode, kind, mu / bulk)
 
@@ -440,8 +441,7 @@ def refuse_compressible(design: Design, what: str) -> None:
     """ValueError if ``design``'s bulk modulus changes its stiffness (radial, conical, a finite
     axial bushing): ``what`` is computed for the material's branches alone, and the bulk spring
     in series is none of them."""
-    pure_shear = design.mode == "torsion" or (design.mode == "axial" and design.shape_kind == "long")
-    if design.material.bulk_modulus is not None and not pure_shear:
+    if bulk_correction(design) is not None:
         raise ValueError(f"material.bulk_modulus: {what} is computed from the material branches of an "
                          f"incompressible rubber; leave bulk_modulus out for it (the stiffness honours it)")
 

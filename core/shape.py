@@ -305,6 +305,13 @@ def long_radial_compressible(a: float, b: float, L: float, x):
     return 8.0 * math.pi * L * (1.0 - nu) / (k * math.log(b / a) - (b * b - a * a) / (k * (b * b + a * a)))
 
 
+def pure_shear(mode: str, shape: str | None = None) -> bool:
+    """Whether ``mode`` with ``shape`` (None: the mode's default) shears the rubber without
+    squeezing it, so that its bulk modulus does not matter: torsion, and the long axial bushing."""
+    kind = shape or checked_mode(mode).default_shape
+    return mode == "torsion" or (mode == "axial" and kind == "long")
+
+
 def bulk_factor(geometry: Geometry, mode: str, shape: str | None, x):
     """How much a bulk modulus K changes the shape factor: S(µ/K = x) / S, with S the shape
     factor of :func:`shape_factor` (K/µ = :data:`BULK_RATIO` for the finite-length table, the
@@ -317,7 +324,7 @@ def bulk_factor(geometry: Geometry, mode: str, shape: str | None, x):
     the plane-strain closed form :func:`long_radial_compressible`."""
     a, b, L = _radii(geometry.inner_radius, geometry.outer_radius, geometry.length)
     kind = shape or checked_mode(mode).default_shape
-    if mode == "torsion" or (mode == "axial" and kind == "long"):
+    if pure_shear(mode, kind):
         return np.ones_like(np.asarray(x) * 1.0)
     if kind == "long":  # radial
         return long_radial_compressible(a, b, L, x) / long_shape_factor(a, b, L, "radial")

@@ -320,7 +320,7 @@ def _closed_form_samples(design: Design, draws: list[dict[str, float]], f, x, sh
     if design.effects or slices != 1 or route != "analytic":
         return None
     geometry_varies = any(name in draws[0] for name in GEOMETRY) if draws else False
-    if geometry_varies and design.material.bulk_modulus is not None:
+    if geometry_varies and bulk_correction(design) is not None:
         return None  # the bulk modulus's factor depends on each sample's geometry: design by design
     n, ones = len(draws), (1,) * len(shape)
 
