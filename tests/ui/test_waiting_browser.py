@@ -65,14 +65,45 @@ def upload_150_points(page, tmp_path):
     page.get_by_text("150 points").first.wait_for()
 
 
-def test_the_diagnosis_shows_its_progress_until_its_report_replaces_it(page, explorer_url, tmp_path):
+@pytest.fixture
+def gated_diagnosis(monkeypatch):
+    """The diagnosis held at its first step's second candidate until the test has seen the page
+    say so: ``(reached, release)`` events (a fast machine may otherwise pass every candidate
+    between two of the page's progress polls)."""
+    from app.diagnosis_state import DiagnosisState
+
+    reached, release = threading.Event(), threading.Event()
+    compute = DiagnosisState.compute
+
+    def gated(self, progress=None):
+        def say(fraction, message):
+            if progress is not None:
+                progress(fraction, message)
+            if message.startswith("step 1, candidate 2 of "):
+                reached.set()
+                release.wait(60)
+
+        return compute(self, say)
+
+    monkeypatch.setattr(DiagnosisState, "compute", gated)
+    return reached, release
+
+
+def test_the_diagnosis_shows_its_progress_until_its_report_replaces_it(page, explorer_url, tmp_path,
+                                                                        gated_diagnosis):
     """150 points diagnosed: the page shows which candidate of how many is being fitted, never a
     finished progress ("done…") without the report, and the report arrives with the progress
     gone (once: "done…" for 2.2 s before the report)."""
+    reached, release = gated_diagnosis
     open_explorer(page, explorer_url)
     upload_150_points(page, tmp_path)
     watch(page, r"(fitting|trying|candidate \d+ of \d+|profiling|checking|describing)[^…]*…", "What is left is noise")
     page.get_by_role("button", name="Diagnose").click()
+    try:
+        expect(page.get_by_text(re.compile(r"step 1, candidate 2 of \d+: "))).to_be_visible(timeout=60_000)
+        assert reached.is_set()  # shown while the diagnosis was held there
+    finally:
+        release.set()
     seen = wait_report(page)
     assert not seen["doneAlone"], seen["progress"]
     assert not seen["progressWithReport"]
