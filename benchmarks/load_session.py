@@ -66,10 +66,10 @@ def start_printing_url(command: list[str], env: dict | None = None, timeout: flo
     raise RuntimeError(f"{' '.join(command[:4])}… printed no URL:\n" + "".join(seen[-20:]))
 
 
-def start_explorer(env: dict | None = None) -> tuple[subprocess.Popen, str]:
-    """``bushing serve --port 0 --address 127.0.0.1`` from this tree."""
-    return start_printing_url([sys.executable, "-m", "cli.main", "serve", "--port", "0", "--address", "127.0.0.1"],
-                              env)
+def start_explorer(env: dict | None = None, address: str = "127.0.0.1") -> tuple[subprocess.Popen, str]:
+    """``bushing serve --port 0 --address ADDRESS`` from this tree (another loopback address,
+    127.0.0.2 …, stands in for another host)."""
+    return start_printing_url([sys.executable, "-m", "cli.main", "serve", "--port", "0", "--address", address], env)
 
 
 def start_floor(page: str) -> tuple[subprocess.Popen, str]:
@@ -88,9 +88,9 @@ def stop(proc: subprocess.Popen):
             proc.wait(10)
 
 
-def start_nginx(backends: list[int], workdir: Path) -> tuple[subprocess.Popen, int]:
+def start_nginx(backends: list[int | str], workdir: Path) -> tuple[subprocess.Popen, int]:
     """The Debian nginx with ``deploy/nginx.conf.template`` in front of ``backends`` (ports on
-    127.0.0.1): the process and its port. It inherits a socket bound at a port the OS picked
+    127.0.0.1, or ``host:port``): the process and its port. It inherits a socket bound at a port the OS picked
     (as tests/test_nginx.py does); sticky by the ``bushing_route`` cookie."""
     from app.deploy import nginx_config
 
@@ -110,6 +110,11 @@ def start_nginx(backends: list[int], workdir: Path) -> tuple[subprocess.Popen, i
 
 def port_of(url: str) -> int:
     return int(re.search(r":(\d+)/", url).group(1))
+
+
+def address_of(url: str) -> str:
+    """``host:port`` of a server's ``http://host:port/`` URL."""
+    return re.search(r"//([^/]+)/", url).group(1)
 
 
 def rss_mb(pid: int) -> float:
