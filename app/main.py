@@ -43,6 +43,9 @@ UPLOAD_MESSAGE_BYTES = 16 * 1024 * 1024
 # SESSION_LIFETIME_S; the server looks every SESSION_CHECK_S
 SESSION_LIFETIME_S = 15
 SESSION_CHECK_S = 5
+# the server's options for them (tests/test_sessions_cleaned.py serves with these)
+SESSION_OPTIONS = {"unused_session_lifetime_milliseconds": SESSION_LIFETIME_S * 1000,
+                   "check_unused_sessions_milliseconds": SESSION_CHECK_S * 1000}
 
 
 def flat(view: pn.viewable.Viewer) -> list:
@@ -168,8 +171,7 @@ def serve(port: int = 5006, address: str = "localhost", show: bool = False):
         liveness=True,
         verbose=False,
         websocket_max_message_size=UPLOAD_MESSAGE_BYTES,
-        unused_session_lifetime_milliseconds=SESSION_LIFETIME_S * 1000,
-        check_unused_sessions_milliseconds=SESSION_CHECK_S * 1000,
+        **SESSION_OPTIONS,
     )
     host = "localhost" if address in ("0.0.0.0", "::", "") else address
     print(f"Bushing Explorer: http://{host}:{server.port}/", flush=True)
