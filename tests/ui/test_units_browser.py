@@ -140,6 +140,7 @@ def test_fitted_values_are_shown_short_and_their_link_gives_them_back(page, expl
     assert all(significant_digits(v) <= 4 for v in fields.values()), fields
     mu = next(p for p in PARAMETERS if p.name == "shear_modulus")
     page.wait_for_url(re.compile(f"{mu.url_key}="))  # the link has the fitted design
+    expect(page.locator(".op-summary")).to_have_text(re.compile(r"\|K\| = "))  # drawn after the tab switch
     summary = page.locator(".op-summary").inner_text()
     numbers = {k: v for k, v in parse_qsl(urlsplit(page.url).query) if re.fullmatch(r"-?[\d.]+", v)}
     assert numbers and all(significant_digits(v) <= 9 for v in numbers.values()), numbers
