@@ -12,8 +12,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import nnls
 
-from core.parts import Geometry
-from core.shape import shape_factor, strain_factor
+from core.slices import slice_nodes
 from fmu.build import c_sources, find_compiler
 from fmu.description import CHANNELS, DIRECTIONS
 
@@ -46,10 +45,8 @@ def layers(design, channel: str, slices: int = 1):
     d = design.in_mode(mode)
     if slices == 1 or mode not in ("axial", "torsion"):
         return [d.shape_factor], [d.strain_factor]
-    g = d.geometry
-    r = np.linspace(g.inner_radius, g.outer_radius, slices + 1)
-    parts = [Geometry(float(r0), float(r1), g.length) for r0, r1 in zip(r[:-1], r[1:], strict=True)]
-    return [shape_factor(p, mode) for p in parts], [strain_factor(p, mode) for p in parts]
+    nodes = slice_nodes(d.geometry, mode, slices)  # p = 2c/S, q = 1/S per slice
+    return (1.0 / nodes.q).tolist(), (nodes.p / (2.0 * nodes.q)).tolist()
 
 
 def coefficients_of(design, slices: int = 1, band=(0.1, 2000.0), count: int = 16, **extra):

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #define MAX_ITERATIONS 200
-#define LAYER_TOLERANCE 4e-16  /* relative step in a layer's strain: machine precision */
+#define LAYER_TOLERANCE 2e-15  /* relative step in a layer's strain: a few ulp */
 #define LOAD_TOLERANCE 1e-14   /* relative step in the channel's load: below the spec's 1e-13 */
 
 /* ------------------------------------------------------------------------------------------ */
@@ -217,6 +217,17 @@ static double stress(const law_t *law, const branch_t *br, double eps, double *s
     return sig;
 }
 
+/* a Newton step kept inside the bracket (lo, hi): bisection where it leaves it; away from the
+ * finite bound where the other is not known yet */
+static double bracketed(double x, double step, double lo, double hi)
+{
+    double next = x + step;
+    if (next > lo && next < hi) return next;
+    if (isinf(lo)) return hi - 2.0 * fabs(step);
+    if (isinf(hi)) return lo + 2.0 * fabs(step);
+    return 0.5 * (lo + hi);
+}
+
 /* the strain at which the layer carries the stress `target`; its slope there */
 static int solve_layer(const law_t *law, const double *layer, double a, double target,
                        double guess, double *eps_out, double *slope_out, long *count)
@@ -248,10 +259,14 @@ static int solve_layer(const law_t *law, const double *layer, double a, double t
         if (!isfinite(r) || !(slope > 0.0)) return 1;
         if (r == 0.0) break;
         if (r < 0.0) lo = eps; else hi = eps;
-        double step = -r / slope, next = eps + step;
-        if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);  /* both bounds finite here */
+        double step = -r / slope;
         double tol = LAYER_TOLERANCE * fmax(fabs(eps), fabs(eps - eps_c));
-        if (fabs(next - eps) <= tol || hi - lo <= tol) {
+        if (fabs(step) <= tol) {
+            eps += step;
+            break;
+        }
+        double next = bracketed(eps, step, lo, hi);
+        if (hi - lo <= tol) {
             eps = next;
             break;
         }
@@ -373,8 +388,7 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
                 }
                 if (g == 0.0) break;
                 if (g < 0.0) lo = load; else hi = load;
-                double step = -g / dg, guess = load + step;
-                if (!(guess > lo && guess < hi)) guess = 0.5 * (lo + hi);
+                double step = -g / dg, guess = bracketed(load, step, lo, hi);
                 double tol = LOAD_TOLERANCE * fmax(fabs(load), scale);
                 done = fabs(step) <= tol || hi - lo <= tol;
                 if (!done) {
