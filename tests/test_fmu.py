@@ -322,3 +322,51 @@ def test_fmpy_rebuilds_the_binary_from_the_fmus_sources(built, tmp_path, monkeyp
         outputs.append(np.array(s.getReal(FORCES)))
         s.freeInstance()
     np.testing.assert_allclose(outputs[1], outputs[0], rtol=1e-12)
+
+
+SIMULATE = textwrap.dedent("""
+    import json, sys
+    import numpy as np
+    from fmpy import simulate_fmu
+    path = sys.argv[1]
+    h = 2e-4
+    t = np.arange(0, 0.2 + h / 2, h)
+    names = ["dx", "dy", "dz", "rx", "ry", "rz"]
+    signal = np.zeros(t.size, dtype=[("time", float)] + [(n, float) for n in names])
+    signal["time"] = t
+    for k, n in enumerate(names):
+        signal[n] = (1e-4 if k < 3 else 3e-3) * np.sin(2 * np.pi * (5 + 3 * k) * t)
+    out = simulate_fmu(path, start_time=0.0, stop_time=0.2, step_size=h, output_interval=h, input=signal,
+                       output=["fx", "fy", "fz", "mx", "my", "mz"])
+    print(json.dumps({n: out[n].tolist() for n in out.dtype.names}))
+""")
+
+
+def fmpy_only_python() -> Path:
+    """A Python with only FMPy installed (and what FMPy needs), in a cache directory; created
+    with pip from PyPI the first time."""
+    cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "bushing-explorer" / "fmpy-only"
+    python = cache / "bin" / "python"
+    if not python.exists() or subprocess.run([str(python), "-c", "import fmpy"], check=False,
+                                             capture_output=True).returncode:
+        subprocess.run([sys.executable, "-m", "venv", "--clear", str(cache)], check=True, capture_output=True)
+        subprocess.run([str(python), "-m", "pip", "install", "--quiet", "fmpy"], check=True, capture_output=True)
+    return python
+
+
+def test_fmpy_in_a_python_with_nothing_of_this_project_simulates_the_same(built, tmp_path):
+    result, _, _ = built
+    python = fmpy_only_python()
+    script = tmp_path / "simulate.py"
+    script.write_text(SIMULATE)
+    alone = subprocess.run([str(python), str(script), str(result.path)], cwd=tmp_path, capture_output=True,
+                           text=True, check=True)
+    nothing = subprocess.run([str(python), "-c", "import core"], cwd=tmp_path, check=False, capture_output=True)
+    assert nothing.returncode != 0  # the project is not importable there
+    here = subprocess.run([sys.executable, str(script), str(result.path)], cwd=tmp_path, capture_output=True,
+                          text=True, check=True)
+    a, b = json.loads(alone.stdout), json.loads(here.stdout)
+    assert len(a["time"]) == len(b["time"]) > 900
+    for name in ("fx", "fy", "fz", "mx", "my", "mz"):
+        assert np.max(np.abs(a[name])) > 0
+        np.testing.assert_allclose(a[name], b[name], rtol=1e-12, atol=1e-12 * np.max(np.abs(b[name])))

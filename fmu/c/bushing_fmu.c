@@ -12,36 +12,13 @@
 #include "fmi2Functions.h"
 #include "bushing_kernel.h"
 #include "bushing_resource.h"
+#include "bushing_fmu.h"
 
 #define VR_INPUTS 0
 #define VR_OUTPUTS BK_CHANNELS
 #define VR_PARAMETERS (2 * BK_CHANNELS)
-#define STATE_MAGIC "BUSHFMU"  /* 8 bytes with its terminator */
-#define STATE_VERSION 1u
 
-typedef enum { INSTANTIATED, INITIALIZING, STEPPING, TERMINATED, FAILED } phase_t;
-
-typedef struct {
-    bk_sizes sizes;
-    size_t parameters, states;
-    double *p, *p_start, *state, *next, *work;  /* one block, see instantiate */
-    double in[BK_CHANNELS], out[BK_CHANNELS];
-    double time;
-    phase_t phase;
-    int logging;
-    char name[128];
-    fmi2CallbackFunctions cb;
-} Instance;
-
-typedef struct {  /* an fmi2FMUstate: the instance's values, no pointer into it */
-    size_t parameters, states;
-    double *p, *state;
-    double in[BK_CHANNELS], out[BK_CHANNELS];
-    double time;
-    phase_t phase;
-} Snapshot;
-
-static void log_message(Instance *m, fmi2Status status, const char *category, const char *format,
+void bf_log(Instance *m, fmi2Status status, const char *category, const char *format,
                         ...)
 {
     char text[512];
@@ -54,13 +31,13 @@ static void log_message(Instance *m, fmi2Status status, const char *category, co
     m->cb.logger(m->cb.componentEnvironment, m->name, status, category, "%s", text);
 }
 
-static fmi2Status error(Instance *m, const char *format, const char *detail)
+fmi2Status bf_error(Instance *m, const char *format, const char *detail)
 {
-    log_message(m, fmi2Error, "logStatusError", format, detail);
+    bf_log(m, fmi2Error, "logStatusError", format, detail);
     return fmi2Error;
 }
 
-static void *allocate(Instance *m, size_t count, size_t size)
+void *bf_allocate(Instance *m, size_t count, size_t size)
 {
     return m->cb.allocateMemory(count, size);
 }
@@ -94,31 +71,31 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuT
     probe.cb = *functions;
     snprintf(probe.name, sizeof probe.name, "%s", instanceName ? instanceName : "bushing");
     if (fmuType != fmi2CoSimulation) {
-        error(&probe, "%s", "this FMU is for co-simulation only");
+        bf_error(&probe, "%s", "this FMU is for co-simulation only");
         return NULL;
     }
     if (br_path_from_uri(fmuResourceLocation, path, sizeof path - sizeof BR_FILE - 1)) {
-        error(&probe, "the resource location %s is no local file URI",
+        bf_error(&probe, "the resource location %s is no local file URI",
               fmuResourceLocation ? fmuResourceLocation : "(null)");
         return NULL;
     }
     if (path[0] && path[strlen(path) - 1] != '/') strcat(path, "/");
     strcat(path, BR_FILE);
     if (br_read(path, guid, &sizes, NULL, message, sizeof message)) {
-        error(&probe, "%s", message);
+        bf_error(&probe, "%s", message);
         return NULL;
     }
     if (!fmuGUID || strcmp(fmuGUID, guid)) {
-        error(&probe, "the GUID does not match the resource file's (%s)", guid);
+        bf_error(&probe, "the GUID does not match the resource file's (%s)", guid);
         return NULL;
     }
-    m = allocate(&probe, 1, sizeof(Instance));
+    m = bf_allocate(&probe, 1, sizeof(Instance));
     if (!m) return NULL;
     memcpy(m, &probe, sizeof probe);
     m->sizes = sizes;
     m->parameters = bk_parameter_count(&sizes);
     m->states = bk_state_count(&sizes);
-    m->p = allocate(m, 2 * m->parameters + 2 * m->states + bk_work_count(&sizes), sizeof(double));
+    m->p = bf_allocate(m, 2 * m->parameters + 2 * m->states + bk_work_count(&sizes), sizeof(double));
     if (!m->p) {
         functions->freeMemory(m);
         return NULL;
@@ -128,7 +105,7 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuT
     m->next = m->state + m->states;
     m->work = m->next + m->states;
     if (br_read(path, guid, &sizes, m->p_start, message, sizeof message)) {
-        error(&probe, "%s", message);
+        bf_error(&probe, "%s", message);
         functions->freeMemory(m->p);
         functions->freeMemory(m);
         return NULL;
@@ -137,7 +114,7 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuT
     bk_work_reset(&sizes, m->work);
     m->logging = loggingOn;
     m->phase = INSTANTIATED;
-    log_message(m, fmi2OK, "logAll", "instantiated from %s", path);
+    bf_log(m, fmi2OK, "logAll", "instantiated from %s", path);
     return m;
 }
 
@@ -159,7 +136,7 @@ FMI2_Export fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranc
     (void)stopTimeDefined;
     (void)stopTime;
     if (!m) return fmi2Error;
-    if (m->phase != INSTANTIATED) return error(m, "%s", "fmi2SetupExperiment after instantiation only");
+    if (m->phase != INSTANTIATED) return bf_error(m, "%s", "fmi2SetupExperiment after instantiation only");
     m->time = startTime;
     return fmi2OK;
 }
@@ -168,7 +145,7 @@ FMI2_Export fmi2Status fmi2EnterInitializationMode(fmi2Component c)
 {
     Instance *m = c;
     if (!m) return fmi2Error;
-    if (m->phase != INSTANTIATED) return error(m, "%s", "fmi2EnterInitializationMode: not instantiated");
+    if (m->phase != INSTANTIATED) return bf_error(m, "%s", "fmi2EnterInitializationMode: not instantiated");
     m->phase = INITIALIZING;
     return fmi2OK;
 }
@@ -178,10 +155,10 @@ FMI2_Export fmi2Status fmi2ExitInitializationMode(fmi2Component c)
     Instance *m = c;
     char message[BK_MESSAGE];
     if (!m) return fmi2Error;
-    if (m->phase != INITIALIZING) return error(m, "%s", "fmi2ExitInitializationMode: not initializing");
+    if (m->phase != INITIALIZING) return bf_error(m, "%s", "fmi2ExitInitializationMode: not initializing");
     if (bk_check_parameters(&m->sizes, m->p, message, sizeof message)) {
         m->phase = FAILED;
-        return error(m, "parameter %s", message);
+        return bf_error(m, "parameter %s", message);
     }
     memset(m->state, 0, m->states * sizeof(double));  /* at rest, virgin */
     memset(m->out, 0, sizeof m->out);
@@ -228,7 +205,7 @@ FMI2_Export fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[
         else {
             char text[32];
             snprintf(text, sizeof text, "%u", r);
-            return error(m, "fmi2GetReal: no variable has the value reference %s", text);
+            return bf_error(m, "fmi2GetReal: no variable has the value reference %s", text);
         }
     }
     return fmi2OK;
@@ -245,18 +222,18 @@ FMI2_Export fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[
         if (r < VR_OUTPUTS) {
             m->in[r - VR_INPUTS] = value[i];  /* checked when a step uses it */
         } else if (r < VR_PARAMETERS) {
-            return error(m, "%s", "fmi2SetReal: the outputs fx … mz cannot be set");
+            return bf_error(m, "%s", "fmi2SetReal: the outputs fx … mz cannot be set");
         } else if (r - VR_PARAMETERS < m->parameters) {
             if (m->phase != INSTANTIATED && m->phase != INITIALIZING) {
                 bk_parameter_name(&m->sizes, r - VR_PARAMETERS, name, sizeof name);
-                return error(m, "fmi2SetReal: %s is a fixed parameter, set before initialization "
+                return bf_error(m, "fmi2SetReal: %s is a fixed parameter, set before initialization "
                                 "only", name);
             }
             m->p[r - VR_PARAMETERS] = value[i];  /* checked at fmi2ExitInitializationMode */
         } else {
             char text[32];
             snprintf(text, sizeof text, "%u", r);
-            return error(m, "fmi2SetReal: no variable has the value reference %s", text);
+            return bf_error(m, "fmi2SetReal: no variable has the value reference %s", text);
         }
     }
     return fmi2OK;
@@ -266,7 +243,7 @@ static fmi2Status no_such(fmi2Component c, size_t nvr, const char *what)
 {
     if (!c) return fmi2Error;
     if (nvr == 0) return fmi2OK;
-    return error(c, "%s: the bushing has only Real variables", what);
+    return bf_error(c, "%s: the bushing has only Real variables", what);
 }
 
 FMI2_Export fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -312,151 +289,6 @@ FMI2_Export fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference v
     return no_such(c, nvr, "fmi2SetString");
 }
 
-/* ------------------------------------------------------------------------------------------ */
-/* states: copies of the values, never of the instance's pointers */
-
-static Snapshot *new_snapshot(Instance *m)
-{
-    Snapshot *s = allocate(m, 1, sizeof(Snapshot));
-    if (!s) return NULL;
-    s->p = allocate(m, m->parameters + m->states, sizeof(double));
-    if (!s->p) {
-        m->cb.freeMemory(s);
-        return NULL;
-    }
-    s->state = s->p + m->parameters;
-    s->parameters = m->parameters;
-    s->states = m->states;
-    return s;
-}
-
-FMI2_Export fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
-{
-    Instance *m = c;
-    Snapshot *s;
-    if (!m || !FMUstate) return fmi2Error;
-    s = *FMUstate ? *FMUstate : new_snapshot(m);
-    if (!s) return error(m, "%s", "fmi2GetFMUstate: out of memory");
-    memcpy(s->p, m->p, m->parameters * sizeof(double));
-    memcpy(s->state, m->state, m->states * sizeof(double));
-    memcpy(s->in, m->in, sizeof m->in);
-    memcpy(s->out, m->out, sizeof m->out);
-    s->time = m->time;
-    s->phase = m->phase;
-    *FMUstate = s;
-    return fmi2OK;
-}
-
-FMI2_Export fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
-{
-    Instance *m = c;
-    Snapshot *s = FMUstate;
-    if (!m || !s) return fmi2Error;
-    if (s->parameters != m->parameters || s->states != m->states)
-        return error(m, "%s", "fmi2SetFMUstate: the state is of another bushing");
-    memcpy(m->p, s->p, m->parameters * sizeof(double));
-    memcpy(m->state, s->state, m->states * sizeof(double));
-    memcpy(m->in, s->in, sizeof m->in);
-    memcpy(m->out, s->out, sizeof m->out);
-    m->time = s->time;
-    m->phase = s->phase;
-    bk_work_reset(&m->sizes, m->work);  /* the parameters may have changed */
-    return fmi2OK;
-}
-
-FMI2_Export fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
-{
-    Instance *m = c;
-    Snapshot *s;
-    if (!m || !FMUstate) return fmi2Error;
-    s = *FMUstate;
-    if (s) {
-        m->cb.freeMemory(s->p);
-        m->cb.freeMemory(s);
-    }
-    *FMUstate = NULL;
-    return fmi2OK;
-}
-
-/* the serialized state: "BUSHFMU\0", then unsigned 32-bit version, phase, J and the six layer
- * counts, then doubles: time, inputs, outputs, parameters, states (this machine's byte order:
- * a state loads in another process on the same platform) */
-#define HEADER_WORDS (3 + BK_CHANNELS)
-#define HEADER_BYTES (8 + HEADER_WORDS * 4)
-
-static size_t serialized_size(const Instance *m)
-{
-    return HEADER_BYTES + (1 + 2 * BK_CHANNELS + m->parameters + m->states) * sizeof(double);
-}
-
-FMI2_Export fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate,
-                                                  size_t *size)
-{
-    (void)FMUstate;
-    if (!c || !size) return fmi2Error;
-    *size = serialized_size(c);
-    return fmi2OK;
-}
-
-FMI2_Export fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate,
-                                             fmi2Byte serializedState[], size_t size)
-{
-    Instance *m = c;
-    Snapshot *s = FMUstate;
-    unsigned int header[HEADER_WORDS];
-    char *at = serializedState;
-    if (!m || !s) return fmi2Error;
-    if (size < serialized_size(m)) return error(m, "%s", "fmi2SerializeFMUstate: buffer too small");
-    header[0] = STATE_VERSION;
-    header[1] = (unsigned int)s->phase;
-    header[2] = (unsigned int)m->sizes.exponentials;
-    for (int k = 0; k < BK_CHANNELS; k++) header[3 + k] = (unsigned int)m->sizes.layers[k];
-    memcpy(at, STATE_MAGIC, 8);
-    memcpy(at + 8, header, sizeof header);
-    at += HEADER_BYTES;
-    memcpy(at, &s->time, sizeof(double));
-    at += sizeof(double);
-    memcpy(at, s->in, sizeof s->in);
-    at += sizeof s->in;
-    memcpy(at, s->out, sizeof s->out);
-    at += sizeof s->out;
-    memcpy(at, s->p, (m->parameters + m->states) * sizeof(double));
-    return fmi2OK;
-}
-
-FMI2_Export fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[],
-                                               size_t size, fmi2FMUstate *FMUstate)
-{
-    Instance *m = c;
-    Snapshot *s;
-    unsigned int header[HEADER_WORDS];
-    const char *at = serializedState;
-    if (!m || !FMUstate || !serializedState) return fmi2Error;
-    if (size != serialized_size(m) || memcmp(at, STATE_MAGIC, 8))
-        return error(m, "%s", "fmi2DeSerializeFMUstate: not a serialized state of this bushing");
-    memcpy(header, at + 8, sizeof header);
-    if (header[0] != STATE_VERSION)
-        return error(m, "%s", "fmi2DeSerializeFMUstate: a state of another version");
-    if (header[1] > FAILED || (int)header[2] != m->sizes.exponentials)
-        return error(m, "%s", "fmi2DeSerializeFMUstate: the state is of another bushing");
-    for (int k = 0; k < BK_CHANNELS; k++)
-        if ((int)header[3 + k] != m->sizes.layers[k])
-            return error(m, "%s", "fmi2DeSerializeFMUstate: the state is of another bushing");
-    s = *FMUstate ? *FMUstate : new_snapshot(m);
-    if (!s) return error(m, "%s", "fmi2DeSerializeFMUstate: out of memory");
-    at += HEADER_BYTES;
-    s->phase = (phase_t)header[1];
-    memcpy(&s->time, at, sizeof(double));
-    at += sizeof(double);
-    memcpy(s->in, at, sizeof s->in);
-    at += sizeof s->in;
-    memcpy(s->out, at, sizeof s->out);
-    at += sizeof s->out;
-    memcpy(s->p, at, (m->parameters + m->states) * sizeof(double));
-    *FMUstate = s;
-    return fmi2OK;
-}
-
 FMI2_Export fmi2Status fmi2GetDirectionalDerivative(fmi2Component c,
         const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
         const fmi2ValueReference vKnown_ref[], size_t nKnown, const fmi2Real dvKnown[],
@@ -469,7 +301,7 @@ FMI2_Export fmi2Status fmi2GetDirectionalDerivative(fmi2Component c,
     (void)dvKnown;
     (void)dvUnknown;
     if (!c) return fmi2Error;
-    return error(c, "%s", "directional derivatives are not provided");
+    return bf_error(c, "%s", "directional derivatives are not provided");
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -484,7 +316,7 @@ FMI2_Export fmi2Status fmi2SetRealInputDerivatives(fmi2Component c,
     (void)value;
     if (!c) return fmi2Error;
     if (nvr == 0) return fmi2OK;
-    return error(c, "%s", "the inputs are held over a step: no input derivatives "
+    return bf_error(c, "%s", "the inputs are held over a step: no input derivatives "
                           "(canInterpolateInputs is false)");
 }
 
@@ -496,7 +328,7 @@ FMI2_Export fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c,
     (void)value;
     if (!c) return fmi2Error;
     if (nvr == 0) return fmi2OK;
-    return error(c, "%s", "no output derivatives (maxOutputDerivativeOrder is 0)");
+    return bf_error(c, "%s", "no output derivatives (maxOutputDerivativeOrder is 0)");
 }
 
 FMI2_Export fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
@@ -508,12 +340,12 @@ FMI2_Export fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunication
     double f[BK_CHANNELS];
     (void)noSetFMUStatePriorToCurrentPoint;
     if (!m) return fmi2Error;
-    if (m->phase != STEPPING) return error(m, "%s", "fmi2DoStep: not initialized, or failed");
+    if (m->phase != STEPPING) return bf_error(m, "%s", "fmi2DoStep: not initialized, or failed");
     if (bk_advance(&m->sizes, m->p, m->state, m->next, m->in, communicationStepSize, f, m->work,
                    NULL, message, sizeof message)) {
         char text[BK_MESSAGE + 64];
         snprintf(text, sizeof text, "%s (the step at t = %g s)", message, currentCommunicationPoint);
-        return error(m, "fmi2DoStep: %s", text);  /* the state is left as it was */
+        return bf_error(m, "fmi2DoStep: %s", text);  /* the state is left as it was */
     }
     memcpy(m->state, m->next, m->states * sizeof(double));
     memcpy(m->out, f, sizeof f);
@@ -524,7 +356,7 @@ FMI2_Export fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunication
 FMI2_Export fmi2Status fmi2CancelStep(fmi2Component c)
 {
     if (!c) return fmi2Error;
-    return error(c, "%s", "fmi2CancelStep: steps are never asynchronous");
+    return bf_error(c, "%s", "fmi2CancelStep: steps are never asynchronous");
 }
 
 FMI2_Export fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
