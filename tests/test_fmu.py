@@ -370,3 +370,11 @@ def test_fmpy_in_a_python_with_nothing_of_this_project_simulates_the_same(built,
     for name in ("fx", "fy", "fz", "mx", "my", "mz"):
         assert np.max(np.abs(a[name])) > 0
         np.testing.assert_allclose(a[name], b[name], rtol=1e-12, atol=1e-12 * np.max(np.abs(b[name])))
+
+
+def test_the_fmi_headers_built_against_are_the_ones_fmpy_ships():
+    from fmu.build import FMI_HEADERS, c_sources
+
+    shipped = Path(fmpy.__file__).parent / "c-code"
+    for name in FMI_HEADERS:
+        assert (c_sources() / "fmi2" / name).read_bytes() == (shipped / name).read_bytes()
