@@ -14,6 +14,7 @@ COPY pyproject.toml README.md LICENSE ./
 COPY core ./core
 COPY app ./app
 COPY cli ./cli
+COPY fmu ./fmu
 RUN python3 -m venv /opt/venv && /opt/venv/bin/pip install . \
     && useradd --create-home --uid 10001 bushing
 

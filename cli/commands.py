@@ -29,6 +29,7 @@ from core.rules import DECIMAL, DesignError
 
 from .parser import (  # the command line's words and bounds
     CARD_DISPLACEMENT,
+    MAX_BAND_DECADES,
     MAX_FREQUENCIES,
     MAX_GRID,
     MAX_SLICE_POINTS,
@@ -282,8 +283,34 @@ def _cmd_export(args) -> None:
     _write_text(export(design, args.format, freqs, args.amp, as_json=as_json), args.output)
 
 
+def _cmd_fmu(args) -> None:
+    from core.element import coefficients  # docs/element.md
+
+    from fmu import FmuError, write_fmu
+
+    f1, f2 = args.band
+    if not f1 < f2:
+        raise InputError(f"bushing fmu: --band F1 F2 needs F1 < F2, got {f1:g} {f2:g}")
+    if f2 / f1 > 10.0**MAX_BAND_DECADES:
+        raise InputError(f"bushing fmu: --band {f1:g} {f2:g} is more than {MAX_BAND_DECADES} decades wide")
+    out = Path(args.output)
+    if out.suffix.lower() != ".fmu":
+        raise InputError(f"bushing fmu: -o {args.output!r}: the file name must end in .fmu")
+    if out.is_dir() or not out.parent.is_dir():
+        raise InputError(f"bushing fmu: cannot write {args.output!r}: "
+                         + ("it is a directory" if out.is_dir() else "its directory does not exist"))
+    design = read_design(args.design)
+    try:
+        result = write_fmu(coefficients(design, slices=args.slices, band=(f1, f2)), out,
+                           model_name=design.name or out.stem, band=(f1, f2))
+    except FmuError as exc:
+        raise InputError(f"bushing fmu: {exc}")
+    if result.note:
+        sys.stderr.write(f"bushing fmu: {result.note}\n")
+
+
 COMMANDS = {"stiffness": _cmd_stiffness, "loop": _cmd_loop, "fit": _cmd_fit, "diagnose": _cmd_diagnose,
-            "card": _cmd_card, "export": _cmd_export, "design": _cmd_design}
+            "card": _cmd_card, "export": _cmd_export, "design": _cmd_design, "fmu": _cmd_fmu}
 
 
 def main(argv: list[str] | None = None, parser: argparse.ArgumentParser | None = None,

@@ -20,6 +20,9 @@ MAX_GRID = 1_000_000
 # form does millions a second, the thesis' time-domain simulation about thirty
 MAX_SLICE_POINTS = {"analytic": 20_000_000, "time-domain": 600}
 MAX_LOOP_POINTS = 1_000_000
+# the FMU's band of the fractional derivative's exponentials (docs/element.md): at most 8 decades
+FMU_BAND = (0.1, 2000.0)
+MAX_BAND_DECADES = 8
 CARD_DISPLACEMENT = MODE[TRANSLATIONS[0]].amplitude  # the card's displacements: in mm, as people read them
 
 
@@ -200,6 +203,22 @@ def build_parser() -> argparse.ArgumentParser:
     dz.add_argument("targets", metavar="TARGETS.json", help="targets file (docs/files.md)")
     dz.add_argument("-o", dest="output", metavar="DESIGNS.json",
                     help="write the report here (the statement goes to stdout), not to stdout")
+
+    fm = sub.add_parser(
+        "fmu",
+        help="the bushing as a native FMI 2.0 co-simulation FMU (docs/fmu.md)",
+        description="Write the bushing as an FMI 2.0 co-simulation FMU: inputs dx dy dz (m), rx ry rz (rad), "
+        "outputs fx fy fz (N), mx my mz (N·m), the axis along z; the design's coefficients as parameters; "
+        "the C sources in sources/ and, where a C compiler is found (cc or $CC), the binary for this "
+        "platform (binaries/linux64). Without a compiler the FMU holds the sources only (docs/fmu.md).",
+    )
+    fm.add_argument("design", metavar="DESIGN.json", help="design file (docs/files.md); its mode is not used")
+    fm.add_argument("-o", dest="output", required=True, metavar="BUSHING.fmu", help="the FMU to write")
+    fm.add_argument("--slices", type=_count("--slices", maximum=MAX_SLICES), default=1, metavar="N",
+                    help=f"N slices in series in the axial and torsion channels (default 1, at most {MAX_SLICES})")
+    fm.add_argument("--band", nargs=2, type=_positive("--band"), default=FMU_BAND, metavar=("F1", "F2"),
+                    help=f"the band in Hz the fractional derivative is fitted over (default {FMU_BAND[0]:g} "
+                         f"{FMU_BAND[1]:g}, at most {MAX_BAND_DECADES} decades wide)")
 
     return parser
 

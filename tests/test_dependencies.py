@@ -74,3 +74,19 @@ def test_the_project_has_a_permissive_licence_and_so_has_everything_it_runs_on()
         assert licence.strip(), f"{name} declares no licence"
         words = licence.replace("LGPL", "").replace("Lesser General Public", "")
         assert not any(c in words for c in COPYLEFT), f"{name}: {licence}"
+
+
+def test_fmpy_the_fmus_checks_use_is_a_test_extra_under_bsd_2_clause():
+    """FMPy (the FMU's independent importer and validator, tests/test_fmu.py) declares no licence
+    in its metadata; its licence file says 2-Clause BSD. It is only in the test extra."""
+    from importlib import metadata
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    assert not any(d.lower().startswith("fmpy") for d in project["dependencies"])
+    assert any(d.lower().startswith("fmpy") for d in project["optional-dependencies"]["test"])
+    try:
+        dist = metadata.distribution("fmpy")
+    except metadata.PackageNotFoundError:
+        return  # not installed here: nothing more to read
+    texts = [f.read_text() for f in dist.files or [] if "licen" in str(f).lower()]
+    assert any("2-Clause BSD" in t for t in texts)
