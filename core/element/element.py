@@ -1,0 +1,241 @@
+"""The stateful time-domain element: six uncoupled channels, one step at a time, O(1) per step
+(docs/element.md).
+
+:class:`Element` holds every layer of every channel in flat arrays (layers × exponentials for
+the fractional memory), so a step is a fixed number of array operations whatever the channels,
+slices and history. A channel of one layer without a bulk spring needs no solve: its strain is
+c·x. A channel of layers in series (slices, or a bulk spring) solves for its force F by
+Newton's method on Σ_k ε_k(p_k F)/c_k + C_b F = x, each layer's strain ε_k(τ) exact on its
+friction branch (:func:`core.element.layers.inverse`), safeguarded by a bracket on F (bisection
+where a friction kink throws Newton outside it), to 1e−13 relative.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from ..design import Design
+from ..material import ConvergenceError
+from . import layers
+from .coefficients import CHANNELS, OUTPUTS, Coefficients, coefficients, step_limit
+from .prony import DEFAULT_BAND
+
+STATE_VERSION = 1
+TOLERANCE = 1e-13  # relative, on the channel's drive balance
+MAX_ITER = 100
+_STATE_KEYS = ("eps", "z", "sigf", "eps_s", "sig_s", "direction", "x", "force", "tangent")
+_H_CACHE = 64  # step lengths remembered (e^{−λh} per h)
+
+
+class ElementWarning(UserWarning):
+    """The element is asked for something outside its stated band (a step too coarse for f₂)."""
+
+
+class Element:
+    """The bushing as a time-domain element (docs/element.md).
+
+    Parameters
+    ----------
+    coefficients : Coefficients
+        From :func:`core.element.coefficients`.
+    channels : sequence of str or None, default None
+        Which channels (``dx`` … ``rz``), in this order in inputs and outputs; None: all six.
+
+    The inputs are displacements (m) and angles (rad) in the channels' order; the outputs are
+    forces (N) and moments (N·m). :meth:`trial` leaves the state unchanged, :meth:`commit`
+    advances it; :meth:`state` and :meth:`restore` read and set it (plain arrays, copies).
+    A step longer than T/400 at the band's top f₂ (:attr:`step_limit`) gives an
+    :class:`ElementWarning`, once per step length.
+    """
+
+    def __init__(self, coefficients: Coefficients, channels=None):
+        names = CHANNELS if channels is None else tuple(channels)
+        unknown = [n for n in names if n not in CHANNELS]
+        if unknown or not names or len(set(names)) != len(names):
+            raise ValueError(f"channels: give distinct names among {', '.join(CHANNELS)}, got {channels!r}")
+        co = self.coefficients = coefficients
+        self.channels = names
+        self.outputs = tuple(OUTPUTS[CHANNELS.index(n)] for n in names)
+        self.band = co.band
+        self.error_bound = (co.magnitude_error, co.phase_error)
+        self.step_limit = step_limit(co.band)
+        chs = [co.channels[n] for n in names]
+        S = np.concatenate([ch.S for ch in chs])
+        c = np.concatenate([ch.c for ch in chs])
+        counts = np.array([len(ch.S) for ch in chs])
+        self._chan = np.repeat(np.arange(len(chs)), counts)  # layer → channel
+        self._p = 2.0 * c / S  # stress (Pa) per unit force
+        self._inv_c = 1.0 / c
+        compliance = np.array([ch.compliance for ch in chs])
+        series = (counts > 1) | (compliance > 0)
+        self._direct_ch = np.flatnonzero(~series)
+        self._direct = np.flatnonzero(~series[self._chan])  # their layers, one each, same order
+        self._series_ch = np.flatnonzero(series)
+        self._series = np.flatnonzero(series[self._chan])
+        local = np.searchsorted(self._series_ch, self._chan[self._series])
+        self._series_local = local
+        self._sum = (local[None, :] == np.arange(self._series_ch.size)[:, None]).astype(float)
+        self._compliance = compliance[self._series_ch]
+        self._rates = np.array(co.rate)
+        self._weights = np.array(co.weight)
+        self._mat = (co.mu, co.beta, co.sigma_f_max, co.eps_half)
+        self._h_cache: dict[float, np.ndarray] = {}
+        self._warned: set[float] = set()
+        self.iterations = 0  # Newton iterations of the last step's series solve
+        n_layers, n_terms = S.size, self._rates.size
+        zeros = np.zeros(n_layers)
+        self._s = {"eps": zeros.copy(), "z": np.zeros((n_layers, n_terms)), "sigf": zeros.copy(),
+                   "eps_s": zeros.copy(), "sig_s": zeros.copy(), "direction": zeros.copy(),
+                   "x": np.zeros(len(chs)), "force": np.zeros(len(chs)), "tangent": self._initial_tangent()}
+
+    @classmethod
+    def from_design(cls, design: Design, slices: int = 1, band=DEFAULT_BAND, channels=None) -> Element:
+        """The element of ``design`` (:func:`core.element.coefficients`), fresh from rest."""
+        return cls(coefficients(design, slices, band), channels)
+
+    def channel(self, name: str) -> Element:
+        """A fresh element of the one channel ``name`` (its input and output are length-1 arrays)."""
+        return Element(self.coefficients, (name,))
+
+    # ---- state --------------------------------------------------------------------------
+
+    def state(self) -> dict:
+        """A copy of the state: plain float arrays and the format's ``version``."""
+        out = {k: v.copy() for k, v in self._s.items()}
+        out["version"] = STATE_VERSION
+        return out
+
+    def restore(self, state: dict) -> None:
+        """Set the state to ``state`` (from :meth:`state`, of an element of the same coefficients
+        and channels), copying it; ValueError if it does not fit."""
+        if not isinstance(state, dict) or state.get("version") != STATE_VERSION:
+            raise ValueError(f"state: not an element state of version {STATE_VERSION}")
+        new = {}
+        for k in _STATE_KEYS:
+            v = np.array(state.get(k), dtype=float)
+            if v.shape != self._s[k].shape or not np.all(np.isfinite(v)):
+                raise ValueError(f"state: {k} must be finite numbers of shape {self._s[k].shape}")
+            new[k] = v
+        self._s = new
+
+    # ---- steps --------------------------------------------------------------------------
+
+    def trial(self, x, h: float) -> np.ndarray:
+        """The forces (N, N·m) after a step of ``h`` s with the inputs ``x`` (m, rad) held over it;
+        the state is unchanged."""
+        return self._step(x, h)[0].copy()
+
+    def commit(self, x, h: float) -> np.ndarray:
+        """:meth:`trial`, and the state advances to the end of the step."""
+        force, eps, fr, tangent, xv, decay = self._step(x, h)
+        s = self._s
+        s["z"] = (s["z"] + (eps - s["eps"])[:, None]) * decay
+        s["eps"] = eps
+        s["sigf"], s["eps_s"], s["sig_s"], s["direction"] = fr
+        s["x"], s["force"], s["tangent"] = xv, force, tangent
+        return force.copy()
+
+    # ---- inside -------------------------------------------------------------------------
+
+    def _initial_tangent(self) -> np.ndarray:
+        """dF/dx at rest, elastic with friction's initial slope: the first step's predictor."""
+        mu, _, smax, half = self._mat
+        layer = self._inv_c * self._p / (2.0 * mu + smax / half)
+        compliance = np.bincount(self._chan, layer, minlength=len(self.channels))
+        compliance[self._series_ch] += self._compliance
+        return 1.0 / compliance
+
+    def _decay(self, h: float) -> np.ndarray:
+        """(e^{−λ_j h}, g_j e^{−λ_j h}) stacked, remembered per step length."""
+        got = self._h_cache.get(h)
+        if got is None:
+            if len(self._h_cache) >= _H_CACHE:
+                self._h_cache.clear()
+            decay = np.exp(-self._rates * h)
+            got = self._h_cache[h] = np.stack([decay, self._weights * decay])
+        return got
+
+    def _check(self, x, h):
+        h = float(h) if isinstance(h, (int, float, np.floating, np.integer)) and not isinstance(h, bool) else None
+        if h is None or not (0.0 < h < np.inf):
+            raise ValueError("h: the step must be a positive finite number of seconds")
+        xv = np.asarray(x, dtype=float).reshape(-1)
+        if xv.size != len(self.channels) or not np.all(np.isfinite(xv)):
+            raise ValueError(f"x: give {len(self.channels)} finite inputs ({', '.join(self.channels)}; m and rad)")
+        if h > self.step_limit and h not in self._warned:
+            self._warned.add(h)
+            warnings.warn(ElementWarning(
+                f"step {h:.3g} s is longer than T/400 at the band's top {self.band[1]:g} Hz "
+                f"({self.step_limit:.3g} s): the held input costs more than 0.8 % of the fractional "
+                f"term's phase there; accurate up to {1.0 / (400.0 * h):.3g} Hz"), stacklevel=3)
+        return xv, h
+
+    def _step(self, x, h):
+        xv, h = self._check(x, h)
+        s = self._s
+        co = self.coefficients
+        decay = self._decay(h)
+        a, b = layers.linear_part(co.mu, co.m, co.viscosity, h, decay[1], s["z"], s["eps"])
+        mu, beta, smax, half = self._mat
+        memory = (s["eps"], s["sigf"], s["eps_s"], s["sig_s"], s["direction"])
+        force = np.empty(len(self.channels))
+        eps = np.empty_like(s["eps"])
+        tangent = s["tangent"].copy()
+        fr = [np.empty_like(eps) for _ in range(4)]
+        if self._direct.size:
+            i = self._direct
+            e = xv[self._direct_ch] / self._inv_c[i]
+            sigma, parts = layers.forward(e, tuple(m[i] for m in memory), a, b[i], mu, beta, smax, half)
+            eps[i] = e
+            force[self._direct_ch] = sigma / self._p[i]
+            for out, part in zip(fr, parts, strict=True):
+                out[i] = part
+        self.iterations = 0
+        if self._series.size:
+            i = self._series
+            mem = tuple(m[i] for m in memory)
+            f, e, slope = self._solve(xv[self._series_ch], mem, a, b[i], i)
+            eps[i] = e
+            force[self._series_ch] = f
+            tangent[self._series_ch] = 1.0 / slope
+            d = np.sign(e - mem[0])
+            es, ss, sd = layers.branch(d, *mem)
+            fr[0][i] = np.where(d == 0, mem[1], layers.friction(e, es, ss, sd, smax, half))
+            fr[1][i], fr[2][i], fr[3][i] = es, ss, sd
+        return force, eps, tuple(fr), tangent, xv, decay[0]
+
+    def _solve(self, x, mem, a, b, i):
+        """Newton on each series channel's force F, with a bracket: Σ ε_k(p_k F)/c_k + C_b F = x."""
+        mu, beta, smax, half = self._mat
+        p, inv_c, total, comp = self._p[i], self._inv_c[i], self._sum, self._compliance
+        s = self._s
+        ch = self._series_ch
+        f = s["force"][ch] + s["tangent"][ch] * (x - s["x"][ch])
+        lo = np.full(ch.size, -np.inf)
+        hi = np.full(ch.size, np.inf)
+        for it in range(1, MAX_ITER + 1):
+            fl = f[self._series_local]
+            e, slope = layers.inverse(p * fl, mem, a, b, mu, beta, smax, half)
+            g = total @ (e * inv_c) + comp * f - x
+            dg = total @ (p * inv_c / slope) + comp
+            scale = total @ np.abs(e * inv_c) + comp * np.abs(f) + np.abs(x)
+            if np.all(np.abs(g) <= TOLERANCE * scale):
+                self.iterations = it
+                return f, e, dg
+            hi = np.where(g > 0, f, hi)
+            lo = np.where(g < 0, f, lo)
+            new = f - g / dg
+            outside = ~((new > lo) & (new < hi))
+            new = np.where(outside, 0.5 * (lo + hi), new)
+            width = hi - lo  # inf while a side is unknown
+            collapsed = np.isfinite(width) & (width <= 4e-16 * np.maximum(np.abs(lo), np.abs(hi)))
+            if np.all(collapsed | (np.abs(g) <= TOLERANCE * scale)):
+                self.iterations = it
+                return f, e, dg
+            f = np.where(np.abs(g) <= TOLERANCE * scale, f, new)
+        bad = int(np.argmax(np.abs(g) / np.maximum(scale, 1e-300)))
+        raise ConvergenceError(
+            f"element: the series solve of channel {self.channels[ch[bad]]} did not converge in {MAX_ITER} "
+            f"iterations (input {x[bad]:.6g}, relative residual {abs(g[bad]) / max(scale[bad], 1e-300):.2e})")
