@@ -83,7 +83,7 @@ def inverse(tau, state, a, b, mu, beta, sigma_max, eps_half):
         for _ in range(STIFFENING_MAX_ITER):
             k1 = 3.0 * k3 * eps * eps
             new, slope = _on_branch(tau, a + k1, b - 2.0 * k3 * eps**3, es, ss, s, sigma_max, eps_half)
-            done = np.all(np.abs(new - eps) <= 1e-15 * np.abs(new) + 1e-300)
+            done = np.all(np.abs(new - eps) <= 1e-14 * np.abs(new) + 1e-300)  # a few ulps
             eps = new
             if done:
                 break
