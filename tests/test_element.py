@@ -147,3 +147,20 @@ def test_a_coarse_step_warns_once_with_the_band():
             el.commit(np.zeros(6), 1e-3)
     assert len(record) == 1 and issubclass(record[0].category, ElementWarning)
     assert "2000 Hz" in str(record[0].message) and "accurate up to 2.5 Hz" in str(record[0].message)
+
+
+def test_the_docs_example_runs(tmp_path):
+    import contextlib
+    import io
+    import pathlib
+    import re
+    import runpy
+
+    text = pathlib.Path(__file__).parents[1].joinpath("docs/element.md").read_text(encoding="utf-8")
+    script = tmp_path / "example.py"
+    script.write_text(re.search(r"```python\n(.*?)```", text, re.DOTALL).group(1), encoding="utf-8")
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), warnings.catch_warnings():
+        warnings.simplefilter("error", ElementWarning)
+        runpy.run_path(str(script))
+    assert out.getvalue().startswith("('dz', 'rz')")
