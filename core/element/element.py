@@ -25,7 +25,7 @@ from .prony import DEFAULT_BAND
 STATE_VERSION = 1
 TOLERANCE = 1e-13  # relative, on the channel's drive balance
 MAX_ITER = 100
-_STATE_KEYS = ("eps", "z", "sigf", "eps_s", "sig_s", "direction", "x", "force", "tangent")
+_STATE_KEYS = ("eps", "sigf", "z", "origin_eps", "origin_sig", "x", "force", "tangent")
 _H_CACHE = 64  # step lengths remembered (e^{−λh} per h)
 
 
@@ -62,22 +62,24 @@ class Element:
         self.error_bound = (co.magnitude_error, co.phase_error)
         self.step_limit = step_limit(co.band)
         chs = [co.channels[n] for n in names]
-        S = np.concatenate([ch.S for ch in chs])
-        c = np.concatenate([ch.c for ch in chs])
-        counts = np.array([len(ch.S) for ch in chs])
-        self._chan = np.repeat(np.arange(len(chs)), counts)  # layer → channel
-        self._p = 2.0 * c / S  # stress (Pa) per unit force
-        self._inv_c = 1.0 / c
         compliance = np.array([ch.compliance for ch in chs])
+        counts = np.array([len(ch.S) for ch in chs])
         series = (counts > 1) | (compliance > 0)
-        self._direct_ch = np.flatnonzero(~series)
-        self._direct = np.flatnonzero(~series[self._chan])  # their layers, one each, same order
+        self._direct_ch = np.flatnonzero(~series)  # one layer, no bulk spring: ε = c·x
         self._series_ch = np.flatnonzero(series)
-        self._series = np.flatnonzero(series[self._chan])
-        local = np.searchsorted(self._series_ch, self._chan[self._series])
-        self._series_local = local
+        # the layers, the direct channels' first (one each, in channel order), then the series'
+        ordered = [chs[i] for i in self._direct_ch] + [chs[i] for i in self._series_ch]
+        S = np.concatenate([ch.S for ch in ordered])
+        c = np.concatenate([ch.c for ch in ordered])
+        self._nd = self._direct_ch.size
+        self._p = 2.0 * c / S  # stress (Pa) per unit force
+        self._c = c
+        self._inv_c = 1.0 / c
+        self._counts = counts[self._series_ch]
+        local = np.repeat(np.arange(self._series_ch.size), self._counts)
         self._sum = (local[None, :] == np.arange(self._series_ch.size)[:, None]).astype(float)
         self._compliance = compliance[self._series_ch]
+        self._any_compliance = bool(np.any(self._compliance > 0))
         self._rates = np.array(co.rate)
         self._weights = np.array(co.weight)
         self._mat = (co.mu, co.beta, co.sigma_f_max, co.eps_half)
@@ -85,9 +87,8 @@ class Element:
         self._warned: set[float] = set()
         self.iterations = 0  # Newton iterations of the last step's series solve
         n_layers, n_terms = S.size, self._rates.size
-        zeros = np.zeros(n_layers)
-        self._s = {"eps": zeros.copy(), "z": np.zeros((n_layers, n_terms)), "sigf": zeros.copy(),
-                   "eps_s": zeros.copy(), "sig_s": zeros.copy(), "direction": zeros.copy(),
+        self._s = {"eps": np.zeros(n_layers), "sigf": np.zeros(n_layers), "z": np.zeros((n_layers, n_terms)),
+                   "origin_eps": np.zeros((2, n_layers)), "origin_sig": np.zeros((2, n_layers)),
                    "x": np.zeros(len(chs)), "force": np.zeros(len(chs)), "tangent": self._initial_tangent()}
 
     @classmethod
@@ -129,11 +130,11 @@ class Element:
 
     def commit(self, x, h: float) -> np.ndarray:
         """:meth:`trial`, and the state advances to the end of the step."""
-        force, eps, fr, tangent, xv, decay = self._step(x, h)
+        force, eps, sf, tangent, xv, decay = self._step(x, h)
         s = self._s
         s["z"] = (s["z"] + (eps - s["eps"])[:, None]) * decay
-        s["eps"] = eps
-        s["sigf"], s["eps_s"], s["sig_s"], s["direction"] = fr
+        s["origin_eps"], s["origin_sig"] = layers.moved(eps, s["eps"], sf, s["origin_eps"], s["origin_sig"])
+        s["eps"], s["sigf"] = eps, sf
         s["x"], s["force"], s["tangent"] = xv, force, tangent
         return force.copy()
 
@@ -143,8 +144,9 @@ class Element:
         """dF/dx at rest, elastic with friction's initial slope: the first step's predictor."""
         mu, _, smax, half = self._mat
         layer = self._inv_c * self._p / (2.0 * mu + smax / half)
-        compliance = np.bincount(self._chan, layer, minlength=len(self.channels))
-        compliance[self._series_ch] += self._compliance
+        compliance = np.empty(len(self.channels))
+        compliance[self._direct_ch] = layer[: self._nd]
+        compliance[self._series_ch] = self._sum @ layer[self._nd:] + self._compliance
         return 1.0 / compliance
 
     def _decay(self, h: float) -> np.ndarray:
@@ -179,63 +181,69 @@ class Element:
         decay = self._decay(h)
         a, b = layers.linear_part(co.mu, co.m, co.viscosity, h, decay[1], s["z"], s["eps"])
         mu, beta, smax, half = self._mat
-        memory = (s["eps"], s["sigf"], s["eps_s"], s["sig_s"], s["direction"])
+        A, B = layers.branch_shape(s["origin_sig"], smax, half)
         force = np.empty(len(self.channels))
-        eps = np.empty_like(s["eps"])
-        tangent = s["tangent"].copy()
-        fr = [np.empty_like(eps) for _ in range(4)]
-        if self._direct.size:
-            i = self._direct
-            e = xv[self._direct_ch] / self._inv_c[i]
-            sigma, parts = layers.forward(e, tuple(m[i] for m in memory), a, b[i], mu, beta, smax, half)
-            eps[i] = e
-            force[self._direct_ch] = sigma / self._p[i]
-            for out, part in zip(fr, parts, strict=True):
-                out[i] = part
-        self.iterations = 0
-        if self._series.size:
-            i = self._series
-            mem = tuple(m[i] for m in memory)
-            f, e, slope = self._solve(xv[self._series_ch], mem, a, b[i], i)
-            eps[i] = e
+        tangent = s["tangent"]
+        nd = self._nd
+        if nd == len(self._p):  # every channel direct
+            eps = xv[self._direct_ch] * self._c
+        else:
+            eps = np.empty_like(s["eps"])
+            eps[:nd] = xv[self._direct_ch] * self._c[:nd]
+            tangent = tangent.copy()
+            i = slice(nd, None)
+            solve = layers.Inverse(a, b[i], s["eps"][i], s["sigf"][i], s["origin_eps"][:, i], s["origin_sig"][:, i],
+                                   A[:, i], B[:, i], mu, beta)
+            f, eps[i], slope = self._solve(xv[self._series_ch], solve)
             force[self._series_ch] = f
             tangent[self._series_ch] = 1.0 / slope
-            d = np.sign(e - mem[0])
-            es, ss, sd = layers.branch(d, *mem)
-            fr[0][i] = np.where(d == 0, mem[1], layers.friction(e, es, ss, sd, smax, half))
-            fr[1][i], fr[2][i], fr[3][i] = es, ss, sd
-        return force, eps, tuple(fr), tangent, xv, decay[0]
+        sf = layers.friction(eps, s["eps"], s["sigf"], s["origin_eps"], s["origin_sig"], A, B)
+        if nd:
+            sigma = a * eps[:nd] + b[:nd] + sf[:nd]
+            if beta:
+                sigma = sigma + 2.0 * mu * beta * eps[:nd] ** 3
+            force[self._direct_ch] = sigma / self._p[:nd]
+        else:
+            self.iterations = 0
+        return force, eps, sf, tangent, xv, decay[0]
 
-    def _solve(self, x, mem, a, b, i):
-        """Newton on each series channel's force F, with a bracket: Σ ε_k(p_k F)/c_k + C_b F = x."""
-        mu, beta, smax, half = self._mat
-        p, inv_c, total, comp = self._p[i], self._inv_c[i], self._sum, self._compliance
+    def _solve(self, x, inverse):
+        """Newton on each series channel's force F, with a bracket: Σ ε_k(p_k F)/c_k + C_b F = x.
+        Returns (F, the layers' strains, dx/dF)."""
+        nd = self._nd
+        p, inv_c, total, comp = self._p[nd:], self._inv_c[nd:], self._sum, self._compliance
+        p_inv_c = p * inv_c
         s = self._s
         ch = self._series_ch
-        f = s["force"][ch] + s["tangent"][ch] * (x - s["x"][ch])
+        k = s["tangent"][ch]
+        f = s["force"][ch] + k * (x - s["x"][ch])
+        tol = TOLERANCE * (np.abs(x) + np.abs(s["force"][ch]) / k)  # the layers' displacements' size
         lo = np.full(ch.size, -np.inf)
         hi = np.full(ch.size, np.inf)
+        bisected = False
         for it in range(1, MAX_ITER + 1):
-            fl = f[self._series_local]
-            e, slope = layers.inverse(p * fl, mem, a, b, mu, beta, smax, half)
-            g = total @ (e * inv_c) + comp * f - x
-            dg = total @ (p * inv_c / slope) + comp
-            scale = total @ np.abs(e * inv_c) + comp * np.abs(f) + np.abs(x)
-            if np.all(np.abs(g) <= TOLERANCE * scale):
+            e, slope = inverse(p * np.repeat(f, self._counts))
+            g = total @ (e * inv_c) - x
+            dg = total @ (p_inv_c / slope)
+            if self._any_compliance:
+                g += comp * f
+                dg += comp
+            done = np.abs(g) <= tol
+            if bisected:  # a bracket as narrow as the floats allow counts as converged
+                width = hi - lo
+                done |= np.isfinite(width) & (width <= 4e-16 * np.maximum(np.abs(lo), np.abs(hi)))
+            if done.all():
                 self.iterations = it
                 return f, e, dg
             hi = np.where(g > 0, f, hi)
             lo = np.where(g < 0, f, lo)
             new = f - g / dg
-            outside = ~((new > lo) & (new < hi))
-            new = np.where(outside, 0.5 * (lo + hi), new)
-            width = hi - lo  # inf while a side is unknown
-            collapsed = np.isfinite(width) & (width <= 4e-16 * np.maximum(np.abs(lo), np.abs(hi)))
-            if np.all(collapsed | (np.abs(g) <= TOLERANCE * scale)):
-                self.iterations = it
-                return f, e, dg
-            f = np.where(np.abs(g) <= TOLERANCE * scale, f, new)
-        bad = int(np.argmax(np.abs(g) / np.maximum(scale, 1e-300)))
+            outside = (new <= lo) | (new >= hi)
+            if outside.any():  # a kink threw Newton out of the bracket: bisect (both sides known there)
+                bisected = True
+                new = np.where(outside, 0.5 * (lo + hi), new)
+            f = np.where(done, f, new)
+        bad = int(np.argmax(np.abs(g) / tol))
         raise ConvergenceError(
             f"element: the series solve of channel {self.channels[ch[bad]]} did not converge in {MAX_ITER} "
-            f"iterations (input {x[bad]:.6g}, relative residual {abs(g[bad]) / max(scale[bad], 1e-300):.2e})")
+            f"iterations (input {x[bad]:.6g}, residual {abs(g[bad]) / tol[bad] * TOLERANCE:.2e} of its size)")

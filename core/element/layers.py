@@ -5,8 +5,12 @@ In a step of length h with the strain held at its new value ε, a layer's stress
     σ(ε) = a ε + b + 2µβε³ + σ_f(ε),
 
 a and b from the elastic branch, the exponentials and the viscosity (:func:`linear_part`), σ_f
-Berg's friction (eq 6) from the layer's reversal memory. Every function takes and returns
-arrays over layers; stresses in Pa, strains dimensionless.
+Berg's friction (eq 6). The friction memory is kept as two branch origins per layer: the
+point (ε_s, σ_s) the stress rises from if the strain rises (row 0, s = +1) and the one it falls
+from if the strain falls (row 1, s = −1). A rise keeps row 0 and makes the new point row 1 (a
+fall reverses there), a fall the other way round; a strain that does not move changes neither.
+This is Berg's reversal memory (the last reversal point, the direction, the last point) in
+another form. Arrays over layers; stresses in Pa, strains dimensionless.
 """
 
 from __future__ import annotations
@@ -16,80 +20,91 @@ import numpy as np
 from ..material import ConvergenceError
 
 STIFFENING_MAX_ITER = 60
+SIGN = np.array([[1.0], [-1.0]])  # s of the rising and the falling branch
 
 
 def linear_part(mu, m, viscosity, h, wh, z, eps):
-    """(a, b) of σ = a ε + b + …: a = 2µ + m Σ_j g_j e^{−λ_j h} + c_v/h (Pa) and
-    b = m Σ_j g_j e^{−λ_j h} z_j − (a − 2µ) ε_n (Pa), with ``wh`` = g_j e^{−λ_j h}, ``z`` the
-    exponentials' states (layers × terms) and ``eps`` the committed strains ε_n."""
+    """(a, b) of σ = a ε + b + …: a = 2µ + m Σ_j g_j e^{−λ_j h} + c_v/h (Pa, one number) and
+    b = m Σ_j g_j e^{−λ_j h} z_j − (a − 2µ) ε_n (Pa per layer), with ``wh`` = g_j e^{−λ_j h},
+    ``z`` the exponentials' states (layers × terms) and ``eps`` the committed strains ε_n."""
     k = m * float(np.sum(wh)) + viscosity / h
     return 2.0 * mu + k, m * (z @ wh) - k * eps
 
 
-def branch(d, eps_last, sigf, eps_s, sig_s, direction):
-    """The friction branch of a motion in direction ``d`` (+1, −1, 0 for none) from the committed
-    point: (ε_s, σ_s, s), the reversal point and direction. Against the last direction the layer
-    reverses at its committed point (ε, σ_f); from the virgin state (s = 0) it takes ``d``."""
-    rev = d * direction < 0
-    return (np.where(rev, eps_last, eps_s), np.where(rev, sigf, sig_s), np.where(d != 0, d, direction))
+def branch_shape(origin_sig, sigma_max, eps_half):
+    """(A, B) of Berg's law on each branch: A = σ_max − sσ_s (Pa), B = ε½(1 − sσ_s/σ_max)."""
+    return sigma_max - SIGN * origin_sig, eps_half * (1.0 - SIGN * origin_sig / sigma_max)
 
 
-def friction(eps, es, ss, s, sigma_max, eps_half):
-    """Berg's law (eq 6) on the branch (ε_s, σ_s, s): σ_s + u(σ_max − sσ_s)/(ε½(1 − sσ_s/σ_max) + su)."""
+def friction(eps, eps_last, sigf, origin_eps, origin_sig, A, B):
+    """Berg's law (eq 6) at the strains ``eps`` on the branch their motion from ``eps_last``
+    takes: σ_s + u A/(B + s u), u = ε − ε_s; the committed ``sigf`` where the strain has not moved."""
+    up = eps > eps_last
+    es = np.where(up, origin_eps[0], origin_eps[1])
     u = eps - es
-    return ss + u * (sigma_max - s * ss) / (eps_half * (1.0 - s * ss / sigma_max) + s * u)
+    s = np.where(up, 1.0, -1.0)
+    sf = np.where(up, origin_sig[0], origin_sig[1]) + u * np.where(up, A[0], A[1]) / (np.where(up, B[0], B[1]) + s * u)
+    return np.where(eps == eps_last, sigf, sf)
 
 
-def forward(eps, state, a, b, mu, beta, sigma_max, eps_half):
-    """The stress at the strains ``eps``, with (σ_f, ε_s, σ_s, s) to commit. ``state`` is
-    (ε_n, σ_f, ε_s, σ_s, s) of the committed step."""
-    eps_last, sigf = state[0], state[1]
-    d = np.sign(eps - eps_last)
-    es, ss, s = branch(d, *state)
-    sf = np.where(d == 0, sigf, friction(eps, es, ss, s, sigma_max, eps_half))
-    sigma = a * eps + b + sf
-    if beta:
-        sigma = sigma + 2.0 * mu * beta * eps**3
-    return sigma, (sf, es, ss, s)
+def moved(eps, eps_last, sf, origin_eps, origin_sig):
+    """The branch origins after committing the strains ``eps`` (friction stress ``sf``)."""
+    new_eps, new_sig = origin_eps.copy(), origin_sig.copy()
+    down, up = eps < eps_last, eps > eps_last
+    new_eps[0] = np.where(down, eps, origin_eps[0])
+    new_sig[0] = np.where(down, sf, origin_sig[0])
+    new_eps[1] = np.where(up, eps, origin_eps[1])
+    new_sig[1] = np.where(up, sf, origin_sig[1])
+    return new_eps, new_sig
 
 
-def _on_branch(tau, a, b, es, ss, s, sigma_max, eps_half):
-    """The strain where a ε + b + σ_f(ε) = τ on the branch (ε_s, σ_s, s) (a quadratic in
-    v = s(ε − ε_s) ≥ 0, solved without cancellation), and σ_f's slope there."""
-    A = sigma_max - s * ss
-    B = eps_half * (1.0 - s * ss / sigma_max)
-    rho = np.maximum(s * (tau - b - ss - a * es), 0.0)
-    q = a * B + A - rho
-    root = np.sqrt(q * q + 4.0 * a * rho * B)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        v = np.where(q >= 0.0, 2.0 * rho * B / (q + root), (root - q) / (2.0 * a))
-    return es + s * v, A * B / (B + v) ** 2
-
-
-def inverse(tau, state, a, b, mu, beta, sigma_max, eps_half):
-    """The strains where each layer's stress is ``tau``, and dσ/dε there (Pa): σ is increasing,
+class Inverse:
+    """The strains where each layer's stress is a target τ, for one step: σ is increasing, so
     the branch follows from τ against the stress at the committed strain, and on a branch the
-    strain solves a quadratic (exact without stiffening; with it the cubic is linearised at the
-    last strain and the quadratic solved again until the strain stops changing)."""
-    eps_last, sigf = state[0], state[1]
-    kink = a * eps_last + b + sigf
-    if beta:
-        kink = kink + 2.0 * mu * beta * eps_last**3
-    d = np.sign(tau - kink)
-    es, ss, s = branch(d, *state)
-    eps, slope = _on_branch(tau, a, b, es, ss, s, sigma_max, eps_half)
-    if beta:
-        k3 = 2.0 * mu * beta
-        for _ in range(STIFFENING_MAX_ITER):
-            k1 = 3.0 * k3 * eps * eps
-            new, slope = _on_branch(tau, a + k1, b - 2.0 * k3 * eps**3, es, ss, s, sigma_max, eps_half)
-            done = np.all(np.abs(new - eps) <= 1e-14 * np.abs(new) + 1e-300)  # a few ulps
-            eps = new
-            if done:
-                break
-        else:
-            raise ConvergenceError("element: a layer's strain with strain stiffening did not converge in "
-                                   f"{STIFFENING_MAX_ITER} iterations")
-        slope = slope + 3.0 * k3 * eps * eps
-    eps = np.where(d == 0, eps_last, eps)
-    return eps, a + slope
+    strain solves a quadratic in v = s(ε − ε_s) ≥ 0 (exact without stiffening; with it the
+    cubic is linearised at the last strain and the quadratic solved again until the strain stops
+    changing). Both branches are solved at once (rows), then the right one taken."""
+
+    def __init__(self, a, b, eps_last, sigf, origin_eps, origin_sig, A, B, mu, beta):
+        self.b, self.es, self.ss, self.A, self.B = b, origin_eps, origin_sig, A, B
+        self.k3 = 2.0 * mu * beta
+        self.kink = a * eps_last + b + sigf + (self.k3 * eps_last**3 if beta else 0.0)
+        self.eps_last = eps_last
+        self._set(a, b)
+
+    def _set(self, a, b):
+        self.a = a
+        self.C = b + self.ss + a * self.es
+        self.aBA = a * self.B + self.A
+        self.fourAB = 4.0 * a * self.B
+        self.inv2a = 0.5 / a
+
+    def _solve(self, tau):
+        rho = np.maximum(SIGN * (tau - self.C), 0.0)
+        q = self.aBA - rho
+        root = np.sqrt(q * q + self.fourAB * rho)
+        v = np.where(q >= 0.0, 2.0 * self.B * rho / (np.abs(q) + root), (root - q) * self.inv2a)
+        return self.es + SIGN * v, self.A * self.B / (self.B + v) ** 2
+
+    def __call__(self, tau):
+        """(ε, dσ/dε) at the targets ``tau`` (Pa), strains dimensionless, slope in Pa."""
+        up = tau > self.kink
+        eps2, slope2 = self._solve(tau)
+        eps = np.where(up, eps2[0], eps2[1])
+        if self.k3:
+            a0, b0 = self.a, self.b
+            for _ in range(STIFFENING_MAX_ITER):
+                self._set(a0 + 3.0 * self.k3 * eps * eps, b0 - 2.0 * self.k3 * eps**3)
+                eps2, slope2 = self._solve(tau)
+                new = np.where(up, eps2[0], eps2[1])
+                done = np.all(np.abs(new - eps) <= 1e-14 * np.abs(new) + 1e-300)  # a few ulps
+                eps = new
+                if done:
+                    break
+            else:
+                raise ConvergenceError("element: a layer's strain with strain stiffening did not converge in "
+                                       f"{STIFFENING_MAX_ITER} iterations")
+            slope = self.a + np.where(up, slope2[0], slope2[1])  # a here includes 3k3ε² of the last pass
+            self._set(a0, b0)
+            return eps, slope
+        return eps, self.a + np.where(up, slope2[0], slope2[1])
