@@ -78,6 +78,11 @@ class Element:
         self._counts = counts[self._series_ch]
         local = np.repeat(np.arange(self._series_ch.size), self._counts)
         self._sum = (local[None, :] == np.arange(self._series_ch.size)[:, None]).astype(float)
+        ns = S.size - self._nd
+        self._to_layers = self._sum * self._p[self._nd:]  # F (channels) @ this: the layers' stresses τ = p F
+        self._drive = self._sum * self._inv_c[self._nd:]  # this @ ε: Σ ε_k/c_k per channel
+        self._drive_slope = self._sum * (self._p * self._inv_c)[self._nd:]  # this @ (1/σ'): dx/dF
+        assert self._to_layers.shape == (self._series_ch.size, ns)
         self._compliance = compliance[self._series_ch]
         self._any_compliance = bool(np.any(self._compliance > 0))
         self._rates = np.array(co.rate)
@@ -210,9 +215,7 @@ class Element:
     def _solve(self, x, inverse):
         """Newton on each series channel's force F, with a bracket: Σ ε_k(p_k F)/c_k + C_b F = x.
         Returns (F, the layers' strains, dx/dF)."""
-        nd = self._nd
-        p, inv_c, total, comp = self._p[nd:], self._inv_c[nd:], self._sum, self._compliance
-        p_inv_c = p * inv_c
+        comp = self._compliance
         s = self._s
         ch = self._series_ch
         k = s["tangent"][ch]
@@ -222,9 +225,9 @@ class Element:
         hi = np.full(ch.size, np.inf)
         bisected = False
         for it in range(1, MAX_ITER + 1):
-            e, slope = inverse(p * np.repeat(f, self._counts))
-            g = total @ (e * inv_c) - x
-            dg = total @ (p_inv_c / slope)
+            e, slope = inverse(f @ self._to_layers)
+            g = self._drive @ e - x
+            dg = self._drive_slope @ (1.0 / slope)
             if self._any_compliance:
                 g += comp * f
                 dg += comp
@@ -242,7 +245,7 @@ class Element:
             if outside.any():  # a kink threw Newton out of the bracket: bisect (both sides known there)
                 bisected = True
                 new = np.where(outside, 0.5 * (lo + hi), new)
-            f = np.where(done, f, new)
+            f = new
         bad = int(np.argmax(np.abs(g) / tol))
         raise ConvergenceError(
             f"element: the series solve of channel {self.channels[ch[bad]]} did not converge in {MAX_ITER} "
