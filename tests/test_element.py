@@ -146,7 +146,11 @@ def test_a_coarse_step_warns_once_with_the_band():
         for _ in range(3):
             el.commit(np.zeros(6), 1e-3)
     assert len(record) == 1 and issubclass(record[0].category, ElementWarning)
-    assert "2000 Hz" in str(record[0].message) and "accurate up to 2.5 Hz" in str(record[0].message)
+    message = str(record[0].message)
+    assert "0.1–2000 Hz" in message and "shorter step" in message
+    # the numbers it names are the held input's error (Element.held_error)
+    mag, phase = el.held_error(1e-3)
+    assert f"{100 * mag:.2g} %" in message and f"{phase:.2g} rad" in message and mag > 0.01
 
 
 def test_the_docs_example_runs(tmp_path):

@@ -245,8 +245,3 @@ def coefficients(design: Design, slices: int = 1, band=DEFAULT_BAND) -> Coeffici
         band=band, magnitude_error=mag, phase_error=phase, slices=slices,
     )
 
-
-def step_limit(band) -> float:
-    """The largest step h (s) for the band's top: T/400 at f₂ (docs/element.md, "A step")."""
-    return 1.0 / (400.0 * band[1])
-

@@ -19,14 +19,15 @@ import numpy as np
 from ..design import Design
 from ..material import ConvergenceError
 from . import layers
-from .coefficients import CHANNELS, OUTPUTS, Coefficients, coefficients, step_limit
-from .prony import DEFAULT_BAND
+from .coefficients import CHANNELS, OUTPUTS, Coefficients, coefficients
+from .prony import CHECK_POINTS_PER_DECADE, DEFAULT_BAND
 
 STATE_VERSION = 1
 TOLERANCE = 1e-13  # relative, on the channel's drive balance
 MAX_ITER = 100
 _STATE_KEYS = ("eps", "sigf", "z", "origin_eps", "origin_sig", "x", "force", "tangent")
 _H_CACHE = 64  # step lengths remembered (e^{−λh} per h)
+HELD_LIMIT = (0.01, 0.01)  # relative magnitude, phase (rad): the fractional term's error that warns
 
 
 class ElementWarning(UserWarning):
@@ -46,8 +47,9 @@ class Element:
     The inputs are displacements (m) and angles (rad) in the channels' order; the outputs are
     forces (N) and moments (N·m). :meth:`trial` leaves the state unchanged, :meth:`commit`
     advances it; :meth:`state` and :meth:`restore` read and set it (plain arrays, copies).
-    A step longer than T/400 at the band's top f₂ (:attr:`step_limit`) gives an
-    :class:`ElementWarning`, once per step length.
+    A step whose held input puts the fractional term more than :data:`HELD_LIMIT` off
+    (iω)^α somewhere in the band (:meth:`held_error`) gives an :class:`ElementWarning`, once
+    per step length.
     """
 
     def __init__(self, coefficients: Coefficients, channels=None):
@@ -60,7 +62,6 @@ class Element:
         self.outputs = tuple(OUTPUTS[CHANNELS.index(n)] for n in names)
         self.band = co.band
         self.error_bound = (co.magnitude_error, co.phase_error)
-        self.step_limit = step_limit(co.band)
         chs = [co.channels[n] for n in names]
         compliance = np.array([ch.compliance for ch in chs])
         counts = np.array([len(ch.S) for ch in chs])
@@ -104,6 +105,27 @@ class Element:
     def channel(self, name: str) -> Element:
         """A fresh element of the one channel ``name`` (its input and output are length-1 arrays)."""
         return Element(self.coefficients, (name,))
+
+    def fractional_response(self, frequency_hz, h: float):
+        """What the element's fractional term gives for a harmonic drive sampled every ``h`` s
+        and held over each step, per unit of (iω)^α's coefficient: at the step ends,
+        Σ_j g_j d_j (1 − e^{−iωh}) / (1 − d_j e^{−iωh}), d_j = e^{−λ_j h} (complex; α = 1: the
+        mean rate over the step, (1 − e^{−iωh})/h). Compare with (iω)^α."""
+        w = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
+        e = np.exp(-1j * w * h)
+        if not self._rates.size:
+            return (1.0 - e) / h
+        d = np.exp(-self._rates * h)
+        return (d * self._weights * (1.0 - e[..., None]) / (1.0 - d * e[..., None])).sum(axis=-1)
+
+    def held_error(self, h: float) -> tuple[float, float]:
+        """The fractional term's largest relative magnitude error and phase error (rad) inside
+        the band with the input held over steps of ``h`` s: :meth:`fractional_response` against
+        (iω)^α, the fit's own error included."""
+        f1, f2 = self.band
+        f = np.geomspace(f1, f2, max(int(CHECK_POINTS_PER_DECADE * np.log10(f2 / f1) / 5), 50))
+        r = self.fractional_response(f, h) / (2j * np.pi * f) ** self.coefficients.alpha
+        return float(np.max(np.abs(np.abs(r) - 1.0))), float(np.max(np.abs(np.angle(r))))
 
     # ---- state --------------------------------------------------------------------------
 
@@ -171,12 +193,15 @@ class Element:
         xv = np.asarray(x, dtype=float).reshape(-1)
         if xv.size != len(self.channels) or not np.all(np.isfinite(xv)):
             raise ValueError(f"x: give {len(self.channels)} finite inputs ({', '.join(self.channels)}; m and rad)")
-        if h > self.step_limit and h not in self._warned:
+        if h not in self._warned:
             self._warned.add(h)
-            warnings.warn(ElementWarning(
-                f"step {h:.3g} s is longer than T/400 at the band's top {self.band[1]:g} Hz "
-                f"({self.step_limit:.3g} s): the held input costs more than 0.8 % of the fractional "
-                f"term's phase there; accurate up to {1.0 / (400.0 * h):.3g} Hz"), stacklevel=3)
+            mag, phase = self.held_error(h)
+            if mag > HELD_LIMIT[0] or phase > HELD_LIMIT[1]:
+                warnings.warn(ElementWarning(
+                    f"step {h:.3g} s: with the input held over it, the fractional term is up to "
+                    f"{100 * mag:.2g} % and {phase:.2g} rad off (iω)^α in the band {self.band[0]:g}–"
+                    f"{self.band[1]:g} Hz (warned above {100 * HELD_LIMIT[0]:g} %, {HELD_LIMIT[1]:g} rad): "
+                    "take a shorter step or a lower band top"), stacklevel=4)
         return xv, h
 
     def _step(self, x, h):

@@ -97,7 +97,8 @@ class Inverse:
                 self._set(a0 + 3.0 * self.k3 * eps * eps, b0 - 2.0 * self.k3 * eps**3)
                 eps2, slope2 = self._solve(tau)
                 new = np.where(up, eps2[0], eps2[1])
-                done = np.all(np.abs(new - eps) <= 1e-14 * np.abs(new) + 1e-300)  # a few ulps
+                # a few ulps, or 1e-14 of ε½ at a strain near zero (B ≈ ε½ on the branch)
+                done = np.all(np.abs(new - eps) <= 1e-14 * (np.abs(new) + self.B[0]))
                 eps = new
                 if done:
                     break
