@@ -6,7 +6,7 @@ the fractional memory), so a step is a fixed number of array operations whatever
 slices and history. A channel of one layer without a bulk spring needs no solve: its strain is
 c·x. A channel of layers in series (slices, or a bulk spring) solves for its force F by
 Newton's method on Σ_k ε_k(p_k F)/c_k + C_b F = x, each layer's strain ε_k(τ) exact on its
-friction branch (:func:`core.element.layers.inverse`), safeguarded by a bracket on F (bisection
+friction branch (:class:`core.element.layers.Inverse`), safeguarded by a bracket on F (bisection
 where a friction kink throws Newton outside it), to 1e−13 relative.
 """
 
