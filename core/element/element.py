@@ -25,7 +25,8 @@ from .prony import CHECK_POINTS_PER_DECADE, DEFAULT_BAND
 STATE_VERSION = 1
 TOLERANCE = 1e-13  # relative, on the channel's drive balance
 MAX_ITER = 100
-_STATE_KEYS = ("eps", "sigf", "z", "origin_eps", "origin_sig", "x", "force", "tangent")
+LAST_STEP = 1e-8  # relative residual below which the last Newton step is taken without evaluating
+_STATE_KEYS = ("eps", "sigf", "z", "origin_eps", "origin_sig", "x", "force", "tangent", "slope")
 _H_CACHE = 64  # step lengths remembered (e^{−λh} per h)
 HELD_LIMIT = (0.01, 0.01)  # relative magnitude, phase (rad): the fractional term's error that warns
 
@@ -95,7 +96,8 @@ class Element:
         n_layers, n_terms = S.size, self._rates.size
         self._s = {"eps": np.zeros(n_layers), "sigf": np.zeros(n_layers), "z": np.zeros((n_layers, n_terms)),
                    "origin_eps": np.zeros((2, n_layers)), "origin_sig": np.zeros((2, n_layers)),
-                   "x": np.zeros(len(chs)), "force": np.zeros(len(chs)), "tangent": self._initial_tangent()}
+                   "x": np.zeros(len(chs)), "force": np.zeros(len(chs)), "tangent": self._initial_tangent(),
+                   "slope": np.full(n_layers, 2.0 * co.mu + co.sigma_f_max / co.eps_half)}
 
     @classmethod
     def from_design(cls, design: Design, slices: int = 1, band=DEFAULT_BAND, channels=None) -> Element:
@@ -162,7 +164,8 @@ class Element:
         s["z"] = (s["z"] + (eps - s["eps"])[:, None]) * decay
         s["origin_eps"], s["origin_sig"] = layers.moved(eps, s["eps"], sf, s["origin_eps"], s["origin_sig"])
         s["eps"], s["sigf"] = eps, sf
-        s["x"], s["force"], s["tangent"] = xv, force, tangent
+        s["x"], s["force"] = xv, force
+        s["tangent"], s["slope"] = tangent
         return force.copy()
 
     # ---- inside -------------------------------------------------------------------------
@@ -214,6 +217,7 @@ class Element:
         A, B = layers.branch_shape(s["origin_sig"], smax, half)
         force = np.empty(len(self.channels))
         tangent = s["tangent"]
+        layer_slope = s["slope"]
         nd = self._nd
         if nd == len(self._p):  # every channel direct
             eps = xv[self._direct_ch] * self._c
@@ -221,12 +225,13 @@ class Element:
             eps = np.empty_like(s["eps"])
             eps[:nd] = xv[self._direct_ch] * self._c[:nd]
             tangent = tangent.copy()
+            layer_slope = layer_slope.copy()
             i = slice(nd, None)
             solve = layers.Inverse(a, b[i], s["eps"][i], s["sigf"][i], s["origin_eps"][:, i], s["origin_sig"][:, i],
                                    A[:, i], B[:, i], mu, beta)
-            f, eps[i], slope = self._solve(xv[self._series_ch], solve)
+            f, eps[i], dxdf, layer_slope[i] = self._solve(xv[self._series_ch], solve)
             force[self._series_ch] = f
-            tangent[self._series_ch] = 1.0 / slope
+            tangent[self._series_ch] = 1.0 / dxdf
         sf = layers.friction(eps, s["eps"], s["sigf"], s["origin_eps"], s["origin_sig"], A, B)
         if nd:
             sigma = a * eps[:nd] + b[:nd] + sf[:nd]
@@ -235,7 +240,7 @@ class Element:
             force[self._direct_ch] = sigma / self._p[:nd]
         else:
             self.iterations = 0
-        return force, eps, sf, tangent, xv, decay[0]
+        return force, eps, sf, (tangent, layer_slope), xv, decay[0]
 
     def _solve(self, x, inverse):
         """Newton on each series channel's force F, with a bracket: Σ ε_k(p_k F)/c_k + C_b F = x.
@@ -244,13 +249,17 @@ class Element:
         s = self._s
         ch = self._series_ch
         k = s["tangent"][ch]
-        f = s["force"][ch] + k * (x - s["x"][ch])
+        # predictor: the last tangent, with the layers' stress at their committed strains under
+        # this step's memory (the relaxation since the last step) moved along their last slopes
+        relax = self._drive @ ((inverse.kink - s["force"][ch] @ self._to_layers) / s["slope"][self._nd:])
+        f = s["force"][ch] + k * (x - s["x"][ch] + relax)
         tol = TOLERANCE * (np.abs(x) + np.abs(s["force"][ch]) / k)  # the layers' displacements' size
         lo = np.full(ch.size, -np.inf)
         hi = np.full(ch.size, np.inf)
         bisected = False
         for it in range(1, MAX_ITER + 1):
-            e, slope = inverse(f @ self._to_layers)
+            tau = f @ self._to_layers
+            e, slope = inverse(tau)
             g = self._drive @ e - x
             dg = self._drive_slope @ (1.0 / slope)
             if self._any_compliance:
@@ -262,10 +271,19 @@ class Element:
                 done |= np.isfinite(width) & (width <= 4e-16 * np.maximum(np.abs(lo), np.abs(hi)))
             if done.all():
                 self.iterations = it
-                return f, e, dg
+                return f, e, dg, slope
+            step = -g / dg
+            if not bisected and (np.abs(g) <= LAST_STEP * tol / TOLERANCE).all():
+                # close enough that Newton's next residual, ~ (G''/2) step², is far below the
+                # tolerance: take the step without another evaluation (the layers' strains along
+                # their tangents), unless a layer would cross its friction kink in it
+                dtau = step @ self._to_layers
+                if ((tau + dtau > inverse.kink) == (tau > inverse.kink)).all():
+                    self.iterations = it
+                    return f + step, e + dtau / slope, dg, slope
             hi = np.where(g > 0, f, hi)
             lo = np.where(g < 0, f, lo)
-            new = f - g / dg
+            new = f + step
             outside = (new <= lo) | (new >= hi)
             if outside.any():  # a kink threw Newton out of the bracket: bisect (both sides known there)
                 bisected = True

@@ -32,8 +32,9 @@ def linear_part(mu, m, viscosity, h, wh, z, eps):
 
 
 def branch_shape(origin_sig, sigma_max, eps_half):
-    """(A, B) of Berg's law on each branch: A = σ_max − sσ_s (Pa), B = ε½(1 − sσ_s/σ_max)."""
-    return sigma_max - SIGN * origin_sig, eps_half * (1.0 - SIGN * origin_sig / sigma_max)
+    """(A, B) of Berg's law on each branch: A = σ_max − sσ_s (Pa), B = ε½(1 − sσ_s/σ_max) = (ε½/σ_max) A."""
+    A = sigma_max - SIGN * origin_sig
+    return A, (eps_half / sigma_max) * A
 
 
 def friction(eps, eps_last, sigf, origin_eps, origin_sig, A, B):
@@ -48,14 +49,11 @@ def friction(eps, eps_last, sigf, origin_eps, origin_sig, A, B):
 
 
 def moved(eps, eps_last, sf, origin_eps, origin_sig):
-    """The branch origins after committing the strains ``eps`` (friction stress ``sf``)."""
-    new_eps, new_sig = origin_eps.copy(), origin_sig.copy()
-    down, up = eps < eps_last, eps > eps_last
-    new_eps[0] = np.where(down, eps, origin_eps[0])
-    new_sig[0] = np.where(down, sf, origin_sig[0])
-    new_eps[1] = np.where(up, eps, origin_eps[1])
-    new_sig[1] = np.where(up, sf, origin_sig[1])
-    return new_eps, new_sig
+    """The branch origins after committing the strains ``eps`` (friction stress ``sf``): a fall
+    (s(ε − ε_n) < 0 for s = +1) makes the new point the rising branch's origin, a rise the
+    falling branch's."""
+    reversed_here = SIGN * (eps - eps_last) < 0.0
+    return np.where(reversed_here, eps, origin_eps), np.where(reversed_here, sf, origin_sig)
 
 
 class Inverse:
