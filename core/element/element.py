@@ -254,9 +254,8 @@ class Element:
         relax = self._drive @ ((inverse.kink - s["force"][ch] @ self._to_layers) / s["slope"][self._nd:])
         f = s["force"][ch] + k * (x - s["x"][ch] + relax)
         tol = TOLERANCE * (np.abs(x) + np.abs(s["force"][ch]) / k)  # the layers' displacements' size
-        lo = np.full(ch.size, -np.inf)
-        hi = np.full(ch.size, np.inf)
-        bisected = False
+        tried = []  # (F, residual) of the iterations: the bracket where Newton needs one
+        bracket = None
         for it in range(1, MAX_ITER + 1):
             tau = f @ self._to_layers
             e, slope = inverse(tau)
@@ -265,15 +264,16 @@ class Element:
             if self._any_compliance:
                 g += comp * f
                 dg += comp
-            done = np.abs(g) <= tol
-            if bisected:  # a bracket as narrow as the floats allow counts as converged
-                width = hi - lo
-                done |= np.isfinite(width) & (width <= 4e-16 * np.maximum(np.abs(lo), np.abs(hi)))
+            small = np.abs(g)
+            done = small <= tol
+            if bracket is not None:  # a bracket as narrow as the floats allow counts as converged
+                lo, hi = bracket
+                done |= np.isfinite(hi - lo) & (hi - lo <= 4e-16 * np.maximum(np.abs(lo), np.abs(hi)))
             if done.all():
                 self.iterations = it
                 return f, e, dg, slope
             step = -g / dg
-            if not bisected and (np.abs(g) <= LAST_STEP * tol / TOLERANCE).all():
+            if bracket is None and (small <= LAST_STEP * tol / TOLERANCE).all():
                 # close enough that Newton's next residual, ~ (G''/2) step², is far below the
                 # tolerance: take the step without another evaluation (the layers' strains along
                 # their tangents), unless a layer would cross its friction kink in it
@@ -281,13 +281,15 @@ class Element:
                 if ((tau + dtau > inverse.kink) == (tau > inverse.kink)).all():
                     self.iterations = it
                     return f + step, e + dtau / slope, dg, slope
-            hi = np.where(g > 0, f, hi)
-            lo = np.where(g < 0, f, lo)
+            tried.append((f, g))
             new = f + step
-            outside = (new <= lo) | (new >= hi)
-            if outside.any():  # a kink threw Newton out of the bracket: bisect (both sides known there)
-                bisected = True
-                new = np.where(outside, 0.5 * (lo + hi), new)
+            if it >= 2:  # Newton should have converged by now: keep it inside the bracket
+                fs, gs = np.array([t[0] for t in tried]), np.array([t[1] for t in tried])
+                lo = np.max(np.where(gs < 0, fs, -np.inf), axis=0)
+                hi = np.min(np.where(gs > 0, fs, np.inf), axis=0)
+                bracket = lo, hi
+                outside = (new <= lo) | (new >= hi)
+                new = np.where(outside, 0.5 * (lo + hi), new)  # both sides known where outside
             f = new
         bad = int(np.argmax(np.abs(g) / tol))
         raise ConvergenceError(
