@@ -32,7 +32,8 @@ HELD_LIMIT = (0.01, 0.01)  # relative magnitude, phase (rad): the fractional ter
 
 
 class ElementWarning(UserWarning):
-    """The element is asked for something outside its stated band (a step too coarse for f₂)."""
+    """A step too long for the band: with the input held over it, the fractional term is more than
+    :data:`HELD_LIMIT` off (iω)^α somewhere in the band (:meth:`Element.held_error`)."""
 
 
 class Element:
@@ -80,11 +81,9 @@ class Element:
         self._counts = counts[self._series_ch]
         local = np.repeat(np.arange(self._series_ch.size), self._counts)
         self._sum = (local[None, :] == np.arange(self._series_ch.size)[:, None]).astype(float)
-        ns = S.size - self._nd
         self._to_layers = self._sum * self._p[self._nd:]  # F (channels) @ this: the layers' stresses τ = p F
         self._drive = self._sum * self._inv_c[self._nd:]  # this @ ε: Σ ε_k/c_k per channel
         self._drive_slope = self._sum * (self._p * self._inv_c)[self._nd:]  # this @ (1/σ'): dx/dF
-        assert self._to_layers.shape == (self._series_ch.size, ns)
         self._compliance = compliance[self._series_ch]
         self._any_compliance = bool(np.any(self._compliance > 0))
         self._rates = np.array(co.rate)
