@@ -1,0 +1,247 @@
+"""The element's coefficients from a design (docs/element.md, "Coefficients").
+
+Six channels at the bushing's centre, axis z: ``dx``, ``dy`` radial, ``dz`` axial, ``rx``, ``ry``
+conical, ``rz`` torsion, each the design turned to its direction (:meth:`Design.in_mode`). A
+channel is a stack of layers in series, layer k with shape factor S_k (m or m³/rad) and strain
+factor c_k (1/m or 1/rad), plus a linear compliance C_b (m/N or rad/(N·m)) where a bulk modulus
+squeezes the rubber. N slices (:func:`core.slices.slice_nodes`) are layers where the core
+derives slices (axial and torsion with the long shape factors); elsewhere one layer.
+
+The bulk modulus: where :func:`core.shape.bulk_factor` is the finite-length table's series law
+1/S(x) = (1 + g(x − x₀))/S(x₀), x = µ/K, x₀ = 1/:data:`core.shape.BULK_RATIO`, the stiffness
+1/K = (1 − g x₀)/(S₀ µ) + g/(S₀ K) is exactly a shear layer of shape factor S₀/(1 − g x₀)
+(strain factor √(S/(4V)) by the energy balance, :func:`core.shape.strain_factor_from_shape`)
+in series with the compliance C_b = g/(S₀ K). The long radial closed form
+(:func:`core.shape.long_radial_compressible`) has no such series form and is refused.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..bushing import STRUCTURAL_EFFECTS
+from ..design import Design
+from ..parameters import MODE, THESIS_MODES
+from ..shape import BULK_RATIO, pure_shear, strain_factor_from_shape, table
+from ..slices import slice_nodes
+from .prony import DEFAULT_BAND, MAGNITUDE_TARGET, PHASE_TARGET, check_band, fit_power
+
+CHANNELS = ("dx", "dy", "dz", "rx", "ry", "rz")
+OUTPUTS = ("fx", "fy", "fz", "mx", "my", "mz")
+CHANNEL_MODES = {"dx": "radial", "dy": "radial", "dz": "axial", "rx": "conical", "ry": "conical", "rz": "torsion"}
+MAX_SLICES = 100
+# effects with no time-domain form, and why (docs/element.md)
+REFUSED_EFFECTS = {
+    "rate_amplitude_coupling": "it is defined for harmonic drives only (friction scaled by the drive frequency)",
+    "nonuniform_strain": "use slices instead (the continuum has no finite set of layers)",
+    "wave_effects": "the rubber's mass belongs in the simulation, not in the element",
+    "inertia": "it is a test rig's apparent mass, not the bushing's",
+}
+assert set(STRUCTURAL_EFFECTS) <= set(REFUSED_EFFECTS)
+
+
+@dataclass(frozen=True)
+class ChannelCoefficients:
+    """One channel: its direction and its layers in series.
+
+    Attributes
+    ----------
+    mode : str
+        The design's mode for this channel (axial, torsion, radial, conical).
+    shape : str
+        The shape factor used (``long`` or ``finite``).
+    S : tuple of float
+        The layers' shape factors, m (translations) or m³/rad (rotations).
+    c : tuple of float
+        The layers' strain factors, 1/m or 1/rad.
+    compliance : float
+        The series bulk spring C_b, m/N or rad/(N·m) (0: none).
+    sliced : bool
+        Whether the channel got the asked slices (else one layer).
+    """
+
+    mode: str
+    shape: str
+    S: tuple[float, ...]
+    c: tuple[float, ...]
+    compliance: float
+    sliced: bool
+
+    def as_dict(self) -> dict:
+        return {"mode": self.mode, "shape": self.shape, "S": list(self.S), "c": list(self.c),
+                "compliance": self.compliance, "sliced": self.sliced}
+
+
+@dataclass(frozen=True)
+class Coefficients:
+    """Everything the element (Python or C) needs, SI, by the names of docs/element.md.
+
+    Attributes
+    ----------
+    mu, m, alpha, sigma_f_max, eps_half : float
+        µ (Pa), m (Pa·s^α), α, σ_fmax (Pa), ε½.
+    beta : float
+        Strain stiffening β (0: none).
+    viscosity : float
+        c_v, Pa·s (0: none); with α = 1 it carries the fractional term m too.
+    rate, weight : tuple of float
+        λ_j (1/s) and g_j (s^−α) of the sum of exponentials (empty with α = 1).
+    channels : dict of str to ChannelCoefficients
+        By input name, in :data:`CHANNELS`' order.
+    band : tuple of float
+        (f₁, f₂), Hz: where the fit holds.
+    magnitude_error, phase_error : float
+        The fit's largest relative magnitude error and phase error (rad) inside the band.
+    slices : int
+        The slices asked.
+    """
+
+    mu: float
+    m: float
+    alpha: float
+    sigma_f_max: float
+    eps_half: float
+    beta: float
+    viscosity: float
+    rate: tuple[float, ...]
+    weight: tuple[float, ...]
+    channels: dict
+    band: tuple[float, float]
+    magnitude_error: float
+    phase_error: float
+    slices: int
+
+    @property
+    def fractional_as_viscosity(self) -> bool:
+        """α = 1: the fractional term is m·dε/dt, carried by :attr:`viscosity`."""
+        return self.alpha == 1.0
+
+    @property
+    def meets_target(self) -> bool:
+        return self.magnitude_error <= MAGNITUDE_TARGET and self.phase_error <= PHASE_TARGET
+
+    @property
+    def sliced_channels(self) -> tuple[str, ...]:
+        return tuple(name for name, ch in self.channels.items() if ch.sliced)
+
+    def as_dict(self) -> dict:
+        """A JSON-able dict (lists for the arrays, channels nested by input name)."""
+        return {
+            "mu": self.mu, "m": self.m, "alpha": self.alpha, "sigma_f_max": self.sigma_f_max,
+            "eps_half": self.eps_half, "beta": self.beta, "viscosity": self.viscosity,
+            "rate": list(self.rate), "weight": list(self.weight),
+            "channels": {name: ch.as_dict() for name, ch in self.channels.items()},
+            "band": list(self.band), "magnitude_error": self.magnitude_error,
+            "phase_error": self.phase_error, "slices": self.slices,
+            "sliced_channels": list(self.sliced_channels),
+        }
+
+    def parameters(self) -> list[tuple[str, float, str]]:
+        """The coefficients as (name, value, unit) in docs/element.md's table's order and names
+        (``rate[0]``, ``dz.S[2]``, ``dx.compliance``…): what the FMU's parameters are."""
+        rows = [("mu", self.mu, "Pa"), ("m", self.m, "Pa·s^α"), ("alpha", self.alpha, "–"),
+                ("sigma_f_max", self.sigma_f_max, "Pa"), ("eps_half", self.eps_half, "–"),
+                ("beta", self.beta, "–"), ("viscosity", self.viscosity, "Pa·s")]
+        rows += [(f"rate[{j}]", v, "1/s") for j, v in enumerate(self.rate)]
+        rows += [(f"weight[{j}]", v, "s^−α") for j, v in enumerate(self.weight)]
+        for name, ch in self.channels.items():
+            rotation = MODE[ch.mode].rotation
+            rows += [(f"{name}.S[{k}]", v, "m³/rad" if rotation else "m") for k, v in enumerate(ch.S)]
+            rows += [(f"{name}.c[{k}]", v, "1/rad" if rotation else "1/m") for k, v in enumerate(ch.c)]
+            rows.append((f"{name}.compliance", ch.compliance, "rad/(N·m)" if rotation else "m/N"))
+        return rows
+
+
+def check_slices(slices) -> int:
+    """``slices`` as a whole number 1 … :data:`MAX_SLICES`, or ValueError."""
+    if isinstance(slices, bool) or not isinstance(slices, int) or not 1 <= slices <= MAX_SLICES:
+        raise ValueError(f"slices: must be a whole number from 1 to {MAX_SLICES}, got {slices!r}")
+    return slices
+
+
+def refuse_effects(design: Design) -> None:
+    """ValueError naming the first effect acting in ``design``'s mode that has no time-domain form."""
+    for eid in design.effect_parameters:
+        if eid in REFUSED_EFFECTS:
+            raise ValueError(f"effects.{eid}: the time-domain element has no form for it ({design.mode} "
+                             f"direction): {REFUSED_EFFECTS[eid]}")
+
+
+def _bulk_series(design: Design, s0: float) -> tuple[float, float]:
+    """(shape factor of the shear layer, series compliance C_b) of a compressible rubber."""
+    bulk = design.material.bulk_modulus
+    if bulk is None or pure_shear(design.mode, design.shape_kind):
+        return s0, 0.0
+    if design.shape_kind == "long":
+        raise ValueError(f"material.bulk_modulus: the long {design.mode} closed form of a compressible rubber "
+                         "(plane strain) has no series form for the time-domain element; use shape 'finite'")
+    geo = design.geometry
+    a, b, L = geo.inner_radius, geo.outer_radius, geo.length
+    g = table().slope(design.mode, b / a, L / (b - a))
+    return s0 / (1.0 - g / BULK_RATIO), g / (s0 * bulk)
+
+
+def channel_coefficients(design: Design, slices: int = 1) -> ChannelCoefficients:
+    """The layers of ``design`` in its own mode (see the module's docstring)."""
+    refuse_effects(design)
+    geo = design.geometry
+    if slices > 1 and design.mode in THESIS_MODES and design.shape_kind == "long":
+        nodes = slice_nodes(geo, design.mode, slices)  # p = 2c/S, q = 1/S per slice
+        S = tuple(float(1.0 / q) for q in nodes.q)
+        c = tuple(float(p / (2.0 * q)) for p, q in zip(nodes.p, nodes.q, strict=True))
+        return ChannelCoefficients(design.mode, design.shape_kind, S, c, 0.0, True)
+    s0 = design.shape_factor
+    s, compliance = _bulk_series(design, s0)
+    if compliance:
+        c = strain_factor_from_shape(s, geo.inner_radius, geo.outer_radius, geo.length)
+    else:
+        c = design.strain_factor
+    return ChannelCoefficients(design.mode, design.shape_kind, (float(s),), (float(c),), float(compliance), False)
+
+
+def coefficients(design: Design, slices: int = 1, band=DEFAULT_BAND) -> Coefficients:
+    """The element's coefficients for ``design`` (docs/element.md).
+
+    Parameters
+    ----------
+    design : Design
+        The bushing, in any mode: each channel turns it to its own (:meth:`Design.in_mode`).
+    slices : int, default 1
+        Layers in series for the channels the core slices (axial ``dz`` and torsion ``rz`` with
+        the long shape factors); 1 … :data:`MAX_SLICES`.
+    band : (float, float), default (0.1, 2000)
+        f₁ < f₂ in Hz where the fractional term's sum of exponentials holds.
+
+    Returns
+    -------
+    Coefficients
+        SI values; :meth:`Coefficients.as_dict` is JSON-able.
+
+    Raises
+    ------
+    ValueError
+        If ``slices`` or ``band`` is not allowed, a channel's design has an effect without a
+        time-domain form, or a bulk modulus acts where no series form exists (long radial).
+    """
+    slices = check_slices(slices)
+    band = check_band(band)
+    mat = design.material
+    channels = {name: channel_coefficients(design.in_mode(mode), slices) for name, mode in CHANNEL_MODES.items()}
+    effects = design.in_mode("axial").effect_parameters  # the rubber's effects act in every mode
+    beta = effects.get("strain_stiffening", {}).get("stiffening", 0.0)
+    viscosity = effects.get("viscous", {}).get("viscosity", 0.0)
+    alpha = float(mat.fractional_order)
+    if alpha == 1.0:
+        rate, weight, mag, phase = (), (), 0.0, 0.0
+        viscosity += mat.fractional_coefficient
+    else:
+        fit = fit_power(alpha, band)
+        rate, weight = tuple(fit.rates.tolist()), tuple(fit.weights.tolist())
+        mag, phase = fit.magnitude_error, fit.phase_error
+    return Coefficients(
+        mu=float(mat.shear_modulus), m=float(mat.fractional_coefficient), alpha=alpha,
+        sigma_f_max=float(mat.friction_stress_max), eps_half=float(mat.friction_strain_half),
+        beta=float(beta), viscosity=float(viscosity), rate=rate, weight=weight, channels=channels,
+        band=band, magnitude_error=mag, phase_error=phase, slices=slices,
+    )
+
