@@ -29,7 +29,6 @@ from core.rules import DECIMAL, DesignError
 
 from .parser import (  # the command line's words and bounds
     CARD_DISPLACEMENT,
-    MAX_BAND_DECADES,
     MAX_FREQUENCIES,
     MAX_GRID,
     MAX_SLICE_POINTS,
@@ -284,15 +283,16 @@ def _cmd_export(args) -> None:
 
 
 def _cmd_fmu(args) -> None:
-    from core.element import coefficients  # docs/element.md
-
+    from core.element import (
+        check_band,
+        coefficients,  # docs/element.md
+    )
     from fmu import FmuError, write_fmu
 
-    f1, f2 = args.band
-    if not f1 < f2:
-        raise InputError(f"bushing fmu: --band F1 F2 needs F1 < F2, got {f1:g} {f2:g}")
-    if f2 / f1 > 10.0**MAX_BAND_DECADES:
-        raise InputError(f"bushing fmu: --band {f1:g} {f2:g} is more than {MAX_BAND_DECADES} decades wide")
+    try:
+        f1, f2 = check_band(args.band)  # the element's rule, one implementation
+    except ValueError as exc:
+        raise InputError(f"bushing fmu: --{exc}")
     out = Path(args.output)
     if out.suffix.lower() != ".fmu":
         raise InputError(f"bushing fmu: -o {args.output!r}: the file name must end in .fmu")

@@ -7,6 +7,8 @@ import argparse
 import math
 
 from core.bushing import MAX_SLICES, ROUTES
+from core.element import DEFAULT_BAND
+from core.element.prony import MAX_DECADES as MAX_BAND_DECADES
 from core.io.export import FORMATS
 from core.parameters import BRANCH_PARAMETERS, MODE, ROTATIONS, TRANSLATIONS
 from core.rules import OVERFLOW, WHOLE, RuleError, decimal
@@ -21,8 +23,7 @@ MAX_GRID = 1_000_000
 MAX_SLICE_POINTS = {"analytic": 20_000_000, "time-domain": 600}
 MAX_LOOP_POINTS = 1_000_000
 # the FMU's band of the fractional derivative's exponentials (docs/element.md): at most 8 decades
-FMU_BAND = (0.1, 2000.0)
-MAX_BAND_DECADES = 8
+FMU_BAND = DEFAULT_BAND
 CARD_DISPLACEMENT = MODE[TRANSLATIONS[0]].amplitude  # the card's displacements: in mm, as people read them
 
 

@@ -89,9 +89,11 @@ def _numbers(name: str, values) -> list[float]:
 
 
 def _channel(coefficients: Mapping, channel: str) -> tuple[list[float], list[float], float]:
-    """(S, c, compliance) of a channel: ``coefficients[channel]["S"]`` … or the flat
-    ``coefficients[f"{channel}.S"]`` …"""
-    nested = coefficients.get(channel)
+    """(S, c, compliance) of a channel: ``coefficients["channels"][channel]["S"]`` (as
+    :meth:`core.element.Coefficients.as_dict` has them), ``coefficients[channel]["S"]`` … or the
+    flat ``coefficients[f"{channel}.S"]`` …"""
+    channels = coefficients.get("channels")
+    nested = channels.get(channel) if isinstance(channels, Mapping) else coefficients.get(channel)
     if isinstance(nested, Mapping):
         get = nested.get
     else:

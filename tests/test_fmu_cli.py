@@ -57,13 +57,13 @@ def test_without_a_compiler_it_writes_the_source_only_fmu_and_says_so(design, tm
     (["--slices", 0], "--slices must be at least 1"),
     (["--slices", 1001], "--slices must be at most 1000"),
     (["--slices", 2.5], "--slices must be a whole number"),
-    (["--band", 100, 10], "needs F1 < F2"),
-    (["--band", 10, 10], "needs F1 < F2"),
+    (["--band", 100, 10], "the lower frequency must be below the upper one"),
+    (["--band", 10, 10], "the lower frequency must be below the upper one"),
     (["--band", 0, 10], "--band must be a positive finite number"),
     (["--band", "nan", 10], "--band must be a number"),
     (["--band", 1, "inf"], "--band must be a number"),
     (["--band", 1, "1e400"], "--band must be a positive finite number"),
-    (["--band", 1e-5, 1e4], "more than 8 decades wide"),
+    (["--band", 1e-5, 1e4], "at most 8 decades wide"),
     (["--band", 1], "expected 2 arguments"),
 ])
 def test_bad_options_are_one_line_and_status_2(design, tmp_path, capsys, args, words, element):
