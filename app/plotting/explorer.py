@@ -19,6 +19,7 @@ from .style import (
     OPERATING_COLOR,
     REFERENCE_STYLE,
     SWEEP_PALETTES,
+    axis_dimension,
     band_area,
     band_label,
     curve,
@@ -117,7 +118,8 @@ def sweep_layer(design: Design, freq_range: tuple[float, float], quantity: str, 
     Cached on these values: they change with the design, the sweep range and the axes, not with
     the operating point, and a change of the operating point finds the same curves (objects a
     live plot sends no data for)."""
-    dims = ranged(dimensions(design.mode), {against: ranges[0], quantity: ranges[1]})
+    dims = {against: axis_dimension(design.mode, against, ranges[0]),
+            quantity: axis_dimension(design.mode, quantity, ranges[1])}
     if against == "frequency":
         sweep = curves.frequency_sweep(design, np.linspace(*freq_range, n_freq), curves.sweep_amplitudes(design))
         labels = [strain_label(r) for r in curves.SWEEP_STRAINS]
@@ -138,7 +140,8 @@ def operating_layer(design: Design, freq_range: tuple[float, float], quantity: s
     Cached on these values, as the sweeps are: moving the operating amplitude leaves the curves
     against amplitude as they were (the same objects: a live plot sends them no data), and the
     frequency likewise the curves against frequency."""
-    dims = ranged(dimensions(design.mode), {against: ranges[0], quantity: ranges[1]})
+    dims = {against: axis_dimension(design.mode, against, ranges[0]),
+            quantity: axis_dimension(design.mode, quantity, ranges[1])}
     if against == "frequency":
         operating = curves.frequency_sweep(design, np.linspace(*freq_range, n_freq), at)
     else:
@@ -151,7 +154,7 @@ def marker_layer(mode: str, against: str, x_range: tuple, at: float) -> hv.VLine
     """The operating point's marker at ``at`` on an axis ``against`` of ``x_range`` (:func:`marker`),
     cached on these values: a change that leaves the operating point's coordinate on this axis
     finds the same object."""
-    return marker(at, ranged(dimensions(mode), {against: x_range})[against])
+    return marker(at, axis_dimension(mode, against, x_range))
 
 
 def explorer_overlays(data: curves.ExplorerData, dims: dict | None = None) -> dict:
