@@ -108,6 +108,8 @@ def reuse_unchanged(old: hv.Overlay | hv.Element | None, new: hv.Overlay | hv.El
     items = [o if _same_data(o, n) else n for o, n in zip(old.values(), new.values())]
     if all(i is o for i, o in zip(items, old.values())):
         return old
+    if all(i is n for i, n in zip(items, new.values())):
+        return new  # nothing to take from old (unchanged elements came as the same objects): no new overlay
     return new.clone(items)
 
 

@@ -19,6 +19,7 @@ from .style import (
     OPERATING_COLOR,
     REFERENCE_STYLE,
     SWEEP_PALETTES,
+    axis_dimension,
     band_area,
     band_label,
     curve,
@@ -72,25 +73,37 @@ def sweep_curves(quantity: str, against: str, sweep: dict, dims: dict, labels) -
             for i, (row, label) in enumerate(zip(sweep[quantity], labels))]
 
 
-def sweep_overlay(quantity: str, against: str, sweep_items: list, dims: dict, *, operating: dict,
-                  at: float, reference: dict | None = None, measured: dict | None = None,
+def _x_of(against: str, sweep: dict):
+    """The x values of a sweep (:func:`app.curves.frequency_sweep`, :func:`app.curves.amplitude_sweep`)
+    on a plot against ``against``."""
+    return sweep["frequency_hz"] if against == "frequency" else sweep["amplitude"]
+
+
+def operating_curve(quantity: str, against: str, operating: dict, dims: dict) -> hv.Curve:
+    """The curve through the operating point (``operating``, a one-row sweep)."""
+    return curve(_x_of(against, operating), operating[quantity][0], dims[against], dims[quantity], "operating point",
+                 color=OPERATING_COLOR, line_width=3)
+
+
+def sweep_overlay(quantity: str, against: str, sweep_items: list, dims: dict, *, operating: dict | hv.Curve,
+                  at: float | hv.VLine, reference: dict | None = None, measured: dict | None = None,
                   band: tuple | None = None, band_name: str = "") -> hv.Overlay:
     """|K| or the loss factor against ``against`` ("frequency" or "amplitude"): the sweeps
     (:func:`sweep_curves`), the tolerance band of the operating curve (``band``: low, high), the
-    curve through the operating point (``operating``, a one-row sweep), a reference design's
-    (dashed), measured points and the marker at ``at``."""
+    curve through the operating point (``operating``, a one-row sweep, or its curve made
+    already), a reference design's (dashed), measured points and the marker at ``at`` (or the
+    marker made already)."""
     xdim, ydim = dims[against], dims[quantity]
-    x_of = (lambda s: s["frequency_hz"]) if against == "frequency" else (lambda s: s["amplitude"])
     items = list(sweep_items)
     if band is not None:
-        items.append(band_area(x_of(operating), *band, xdim, ydim, band_name, OPERATING_COLOR))
+        x = operating.dimension_values(0) if isinstance(operating, hv.Curve) else _x_of(against, operating)
+        items.append(band_area(x, *band, xdim, ydim, band_name, OPERATING_COLOR))
     if reference is not None:
-        items.append(curve(x_of(reference), reference[quantity][0], xdim, ydim, "reference", **REFERENCE_STYLE))
-    items.append(curve(x_of(operating), operating[quantity][0], xdim, ydim, "operating point",
-                       color=OPERATING_COLOR, line_width=3))
+        items.append(curve(_x_of(against, reference), reference[quantity][0], xdim, ydim, "reference", **REFERENCE_STYLE))
+    items.append(operating if isinstance(operating, hv.Curve) else operating_curve(quantity, against, operating, dims))
     if measured is not None:
-        items.append(scatter(x_of(measured), measured[quantity], xdim, ydim, "measured", **MEASURED_STYLE))
-    items.append(marker(at, xdim))
+        items.append(scatter(_x_of(against, measured), measured[quantity], xdim, ydim, "measured", **MEASURED_STYLE))
+    items.append(at if isinstance(at, hv.VLine) else marker(at, xdim))
     return overlay(items, TITLES[(quantity, against)], f"bushing-{quantity}-vs-{against}",
                    logx=against == "amplitude")
 
@@ -105,7 +118,8 @@ def sweep_layer(design: Design, freq_range: tuple[float, float], quantity: str, 
     Cached on these values: they change with the design, the sweep range and the axes, not with
     the operating point, and a change of the operating point finds the same curves (objects a
     live plot sends no data for)."""
-    dims = ranged(dimensions(design.mode), {against: ranges[0], quantity: ranges[1]})
+    dims = {against: axis_dimension(design.mode, against, ranges[0]),
+            quantity: axis_dimension(design.mode, quantity, ranges[1])}
     if against == "frequency":
         sweep = curves.frequency_sweep(design, np.linspace(*freq_range, n_freq), curves.sweep_amplitudes(design))
         labels = [strain_label(r) for r in curves.SWEEP_STRAINS]
@@ -116,22 +130,52 @@ def sweep_layer(design: Design, freq_range: tuple[float, float], quantity: str, 
     return tuple(sweep_curves(quantity, against, sweep, dims, labels))
 
 
+@functools.lru_cache(maxsize=64)
+def operating_layer(design: Design, freq_range: tuple[float, float], quantity: str, against: str, ranges: tuple,
+                    at: float, n_freq: int = 120, n_amp: int = 120) -> hv.Curve:
+    """The curve through the operating point on one plot of ``design`` (:func:`operating_curve`:
+    |K| or the loss factor against frequency at the operating amplitude ``at``, or against
+    amplitude at the operating frequency ``at``), on axes of ``ranges`` as :func:`sweep_layer`'s.
+
+    Cached on these values, as the sweeps are: moving the operating amplitude leaves the curves
+    against amplitude as they were (the same objects: a live plot sends them no data), and the
+    frequency likewise the curves against frequency."""
+    dims = {against: axis_dimension(design.mode, against, ranges[0]),
+            quantity: axis_dimension(design.mode, quantity, ranges[1])}
+    if against == "frequency":
+        operating = curves.frequency_sweep(design, np.linspace(*freq_range, n_freq), at)
+    else:
+        operating = curves.amplitude_sweep(design, curves.amplitude_grid(design, n_amp), at)
+    return operating_curve(quantity, against, operating, dims)
+
+
+@functools.lru_cache(maxsize=64)
+def marker_layer(mode: str, against: str, x_range: tuple, at: float) -> hv.VLine:
+    """The operating point's marker at ``at`` on an axis ``against`` of ``x_range`` (:func:`marker`),
+    cached on these values: a change that leaves the operating point's coordinate on this axis
+    finds the same object."""
+    return marker(at, axis_dimension(mode, against, x_range))
+
+
 def explorer_overlays(data: curves.ExplorerData, dims: dict | None = None) -> dict:
     """The five plots of ``data`` (:func:`app.curves.explorer_data`): ``"loop"`` and one per (quantity,
     against) of :data:`TITLES`. ``dims`` are the dimensions to draw on (a live view passes its
     own, so that its plots keep their axes); the plots carry the data's ranges on clones of them
     (:func:`app.plotting.style.ranged`), ``dims`` are left as they are. The sweeps' curves come
     from :func:`sweep_layer` (the same objects while the design, the sweep range and the axes
-    are)."""
+    are), and so do the operating curves (:func:`operating_layer`) and the markers
+    (:func:`marker_layer`): a change of the operating point builds only what it moves."""
     dims = ranged(dims if dims is not None else dimensions(data.mode), data.ranges)
     out = {"loop": loop_overlay(data.loop, dims, reference=data.reference_loop, measured=data.measured_loop)}
     n_freq, n_amp = (len(data.sweeps[k][c]) for k, c in (("frequency", "frequency_hz"), ("amplitude", "amplitude")))
     for (quantity, against) in TITLES:
         ranges = (tuple(dims[against].range), tuple(dims[quantity].range))
         items = sweep_layer(data.design, data.freq_range, quantity, against, ranges, n_freq, n_amp)
+        other, at = (data.amplitude, data.frequency_hz) if against == "frequency" else (data.frequency_hz, data.amplitude)
         out[(quantity, against)] = sweep_overlay(
-            quantity, against, items, dims, operating=data.operating[against],
-            at=data.frequency_hz if against == "frequency" else data.amplitude,
+            quantity, against, items, dims,
+            operating=operating_layer(data.design, data.freq_range, quantity, against, ranges, float(other), n_freq, n_amp),
+            at=marker_layer(data.mode, against, ranges[0], float(at)),
             reference=data.references[against] if data.references else None, measured=data.measured,
             band=data.bands[against][quantity] if data.bands else None,
             band_name=band_label(data.bands["point"]["percentiles"]) if data.bands else "")

@@ -96,6 +96,20 @@ def ranged(dims: dict[str, hv.Dimension], ranges: dict) -> dict[str, hv.Dimensio
     return out
 
 
+@functools.cache
+def _shared_dimensions(mode: str) -> dict[str, hv.Dimension]:
+    return dimensions(mode)
+
+
+@functools.lru_cache(maxsize=256)
+def axis_dimension(mode: str, name: str, rng: tuple | None = None) -> hv.Dimension:
+    """The dimension ``name`` of ``mode`` (:func:`dimensions`) with the axis range ``rng`` (None:
+    the data's), one shared object per (mode, name, range), never changed: for elements cached by
+    value (:func:`app.plotting.explorer.sweep_layer`), which need no dimensions of their own."""
+    dim = _shared_dimensions(mode)[name]
+    return dim if rng is None else dim.clone(range=tuple(rng))
+
+
 # ---- styled templates ----------------------------------------------------------------------------
 
 

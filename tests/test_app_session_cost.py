@@ -1,0 +1,96 @@
+"""What a session costs the server, fixed by counts (issue #28, cheaper sessions): the walks over
+a page's models while it is built, the HoloViews elements an amplitude change builds, and what a
+second session of the same design builds again. No clock: ``benchmarks/load_client.py`` prints
+the times."""
+
+import pytest
+
+from app.main import App
+from app.plotting import style
+from app.tabs.explorer import GRID
+from tests.helpers import rendered
+
+KEYS = ("loop", *GRID)
+
+
+@pytest.fixture
+def built(monkeypatch):
+    """Every element :func:`app.plotting.style.styled` makes while the test runs (every curve,
+    marker, area and overlay of the plots is made there), in order."""
+    made = []
+    original = style.styled
+
+    def counted(kind, data, **options):
+        element = original(kind, data, **options)
+        made.append(element)
+        return element
+
+    monkeypatch.setattr(style, "styled", counted)
+    return made
+
+
+def elements(app, key) -> list:
+    return list(app.plots.frame(key).values())
+
+
+def test_a_session_s_page_is_built_with_one_walk_over_its_models(monkeypatch):
+    """Bokeh recomputes a document's set of models (a walk over all of them) whenever its last
+    freeze ends. The page is built under one freeze (:class:`app.main.Page`): one walk, at the
+    end, instead of one per root added, for the theme and per linked axis (15 walks of some 540
+    models before); every model is in the document and knows it."""
+    from bokeh.document.models import DocumentModelManager
+
+    walks = []
+    original = DocumentModelManager.recompute
+
+    def counted(self):
+        walks.append(self)
+        original(self)
+
+    monkeypatch.setattr(DocumentModelManager, "recompute", counted)
+    doc = rendered(App().template())
+    assert len(walks) == 1
+    reachable = {m.id for root in doc.roots for m in root.references()}
+    assert {m.id for m in doc.models} == reachable and all(m.document is doc for m in doc.models)
+
+
+def test_an_amplitude_change_builds_only_what_it_moves(built):
+    """Moving the amplitude rebuilds the loop, the curves through the operating point against
+    frequency and the marker on the amplitude axes; the sweeps, the operating curves against
+    amplitude and the frequency markers stay the objects they were (cached by value: a live plot
+    sends them no data). No element is built to be thrown away, and no Bokeh model is replaced:
+    the same models, new data."""
+    app = App()
+    doc = rendered(app.template())
+    # a session's first update of a text adds Panel's stylesheets to it (three models, once; Panel's own)
+    app.state.amplitude = round(app.state.amplitude * 0.8, 6)
+    before = {key: elements(app, key) for key in KEYS}
+    models = {m.id for m in doc.models}
+    built.clear()
+    app.state.amplitude = round(app.state.amplitude * 1.7, 6)
+    after = {key: elements(app, key) for key in KEYS}
+    shown = {id(frame) for key in KEYS for frame in (app.plots.frame(key), *app.plots.frame(key).values())}
+    assert built and all(id(element) in shown for element in built)  # nothing built for nothing
+    for quantity, against in GRID:
+        old, new = before[(quantity, against)], after[(quantity, against)]
+        moved = [n for o, n in zip(old, new) if o is not n]
+        if against == "amplitude":  # only its marker moves
+            assert [type(n).__name__ for n in moved] == ["VLine"]
+        else:  # only its operating curve moves
+            assert [n.label for n in moved] == ["operating point"]
+    assert not any(o is n for o, n in zip(before["loop"], after["loop"]))
+    assert {m.id for m in doc.models} == models
+
+
+def test_a_second_session_of_the_same_design_builds_only_its_loop_and_its_overlays(built):
+    """The curves of a design (the sweeps, the operating curves) and the markers are cached by
+    value, process-wide: a second session of the default design finds the first's objects and
+    builds only its loop's curves and the five overlays that hold them."""
+    first = App()
+    built.clear()
+    second = App()
+    for key in GRID:
+        assert all(a is b for a, b in zip(elements(first, key), elements(second, key)))
+    loop = {id(element) for element in elements(second, "loop")}
+    rest = [element for element in built if id(element) not in loop]
+    assert [type(element).__name__ for element in rest] == ["Overlay"] * len(KEYS)
