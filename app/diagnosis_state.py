@@ -15,6 +15,7 @@ from core.synthetic import MYSTERIES, Mystery
 
 from . import report_curves
 from .state import ExplorerState, read_stiffness
+from .work import Task
 
 
 class DiagnosisState(param.Parameterized):
@@ -79,8 +80,10 @@ class DiagnosisState(param.Parameterized):
 
     # ---- the diagnosis -------------------------------------------------------------------------
 
-    def compute(self, progress=None) -> Diagnosis:
-        """Run the workflow (pure: safe in a worker thread; the view stores the result)."""
+    def task(self) -> Task:
+        """The diagnosis of the loaded data as a :class:`app.work.Task` (it can run in a worker
+        process: the design, the data and the baseline are plain data); ValueError, saying
+        what to do, if it cannot run."""
         if self.data is None:
             raise ValueError("load data first: a stiffness CSV, the measured data, or a mystery data set")
         if not self.baseline:
@@ -92,7 +95,11 @@ class DiagnosisState(param.Parameterized):
         data = self.data  # every mode at once: one material, each mode through its shape factor
         if data.mode is not None and len(set(data.mode)) == 1:
             data = data.of_mode(design.mode)
-        return diagnose(design, data, baseline=[b for b in BRANCHES if b in self.baseline], progress=progress)
+        return Task(diagnose, (design, data), {"baseline": [b for b in BRANCHES if b in self.baseline]})
+
+    def compute(self, progress=None) -> Diagnosis:
+        """Run the workflow here (pure: safe in a worker thread; the view stores the result)."""
+        return self.task()(progress)
 
     def shown(self) -> Diagnosis | None:
         """The result as the plots show it: the rows of the mode it was run in."""

@@ -8,7 +8,7 @@ import sys
 
 import panel as pn
 
-from . import patches
+from . import patches, work
 from .diagnosis_state import DiagnosisState
 from .export import ExportView
 from .fit_state import FitState
@@ -188,6 +188,7 @@ def serve(port: int = 5006, address: str = "localhost", show: bool = False):
         websocket_max_message_size=UPLOAD_MESSAGE_BYTES,
         **SESSION_OPTIONS,
     )
+    work.use_processes()  # long work (the diagnosis) in worker processes, off the pages' interpreter lock
     host = "localhost" if address in ("0.0.0.0", "::", "") else address
     print(f"Bushing Explorer: http://{host}:{server.port}/", flush=True)
     sys.stdout.flush()

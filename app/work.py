@@ -12,19 +12,155 @@ nothing more is written to its document (:func:`page_open`): no progress, no res
 a socket that has closed is what logged ``WebSocketClosedError`` (issue #27, item 15).
 
 No Panel import: the states (:mod:`app.targets_form`) use it too; the views pass the document.
+
+**Work in another process.** A worker thread shares the server's interpreter lock: while one
+page's diagnosis computes, every other page's changes wait for their turn at it. A served
+explorer therefore runs a :class:`Task` (a module-level function and its arguments, which can be
+sent to another process) in a pool of worker processes (:func:`use_processes`, called by
+:func:`app.main.serve`; ``BUSHING_WORKERS`` processes, 1 by default): the event loop keeps its core,
+and the work gets its own. The workers are forked from a server process that has imported the
+core (``forkserver``, preloaded), started when the explorer starts, so that the first task pays
+no import. A task's progress comes back through one queue, and is shown as a thread's is. An
+in-process server (the tests', a notebook's) runs tasks in a thread, as before.
 """
 
 from __future__ import annotations
 
 import asyncio
+import atexit
+import itertools
+import logging
+import multiprocessing
+import os
+import threading
 from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+log = logging.getLogger("bushing.app")
+
 PROGRESS_POLL_S = 0.15  # s between two progress updates on the page
 
 Say = Callable[[float, str], None]
+
+
+@dataclass(frozen=True)
+class Task:
+    """Work that can run in another process: ``function(*args, progress=say, **kwargs)``, the
+    function defined at a module's top level, the arguments plain data (designs, measured data)."""
+
+    function: Callable
+    args: tuple = ()
+    kwargs: dict = field(default_factory=dict)
+
+    def __call__(self, say: Say | None = None) -> Any:
+        return self.function(*self.args, progress=say, **self.kwargs)
+
+
+# --- the worker processes ---------------------------------------------------------------------
+
+PRELOAD = ["core.identify.diagnose", "core.identify.fit"]  # imported once, in the fork server
+_pool: ProcessPoolExecutor | None = None
+_pool_lock = threading.Lock()
+_progress: dict[int, list] = {}  # task id → the latest [fraction, message] of a running task
+_ids = itertools.count(1)
+relayed = 0  # progress reports received from the worker processes (tests count them)
+_queue = None  # the workers' progress queue (the parent's end)
+_worker_queue = None  # in a worker: the same queue
+
+
+def workers() -> int:
+    """How many worker processes: ``BUSHING_WORKERS`` (1–64), 1 if unset or not a whole number."""
+    text = os.environ.get("BUSHING_WORKERS", "1").strip()
+    return min(64, max(1, int(text))) if text.isdigit() else 1
+
+
+def use_processes(count: int | None = None) -> None:
+    """Run :class:`Task` work in ``count`` worker processes (:func:`workers` if None) from now on,
+    and start them (a no-op task each), so that the first page's work does not wait for them."""
+    global _pool, _queue
+    with _pool_lock:
+        if _pool is not None:
+            return
+        context = multiprocessing.get_context("forkserver")
+        context.set_forkserver_preload(PRELOAD)
+        _queue = context.Queue()
+        _pool = ProcessPoolExecutor(max_workers=count or workers(), mp_context=context,
+                                    initializer=_start_worker, initargs=(_queue,))
+        threading.Thread(target=_relay, args=(_queue,), name="work-progress", daemon=True).start()
+        for _ in range(count or workers()):
+            _pool.submit(int)
+    atexit.register(stop_processes)
+
+
+def stop_processes() -> None:
+    """Stop the worker processes (work not started is cancelled); tasks run in threads again."""
+    global _pool
+    with _pool_lock:
+        pool, _pool = _pool, None
+    if pool is not None:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _start_worker(queue) -> None:
+    global _worker_queue
+    _worker_queue = queue
+
+
+def _relay(queue) -> None:
+    """In the server: every progress report of the workers into its task's slot."""
+    while True:
+        try:
+            task_id, fraction, message = queue.get()
+        except (EOFError, OSError, ValueError):
+            return
+        global relayed
+        relayed += 1
+        slot = _progress.get(task_id)
+        if slot is not None:
+            slot[:] = [fraction, message]
+
+
+def _run_task(task_id: int, task: Task) -> Any:
+    """In a worker: ``task``, its progress sent to the server with ``task_id``."""
+    def say(fraction: float, message: str):
+        _worker_queue.put((task_id, float(fraction), str(message)))
+
+    return task(say)
+
+
+def _submit(work, latest: list):
+    """``work`` started: in a worker process if it is a :class:`Task` and the processes are on,
+    else in a thread; a future, and the id whose progress ``latest`` receives (or None)."""
+    pool = _pool
+    if isinstance(work, Task) and pool is not None:
+        task_id = next(_ids)
+        _progress[task_id] = latest
+        try:
+            return asyncio.wrap_future(pool.submit(_run_task, task_id, work)), task_id
+        except BrokenProcessPool:
+            _progress.pop(task_id, None)
+            _reset_broken(pool)
+
+    def say(fraction: float, message: str):
+        latest[:] = [fraction, message]
+
+    return asyncio.ensure_future(asyncio.to_thread(work, say)), None
+
+
+def _reset_broken(pool) -> None:
+    """A worker died (killed, out of memory): the pool is replaced by a new one."""
+    global _pool
+    log.warning("a worker process stopped; starting new ones")
+    with _pool_lock:
+        if _pool is pool:
+            _pool = None
+    pool.shutdown(wait=False, cancel_futures=True)
+    use_processes()
 
 
 class PageClosed(Exception):
@@ -43,25 +179,32 @@ def page_open(doc) -> bool:
 
 async def in_thread(work: Callable[[Say], Any], show: Callable[[float, str], None] | None = None,
                     doc=None) -> Any:
-    """``work(say)`` in a worker thread; while it runs, ``show(fraction, message)`` on the event
+    """``work(say)`` in a worker thread (a :class:`Task` in a worker process when they are on:
+    :func:`use_processes`); while it runs, ``show(fraction, message)`` on the event
     loop with the latest ``say`` (fraction clipped to 0–1), only while the page is open and the
     work is not finishing (a fraction of 1: its result comes next, in the caller's push).
     Returns what ``work`` returns, raises what it raises; :class:`PageClosed` if the page closed
     meanwhile (the result would go nowhere). ``doc``: the page's Bokeh document (``pn.state.curdoc``
     in the view that asks)."""
     latest: list = []  # written by the worker, read here on the event loop
-
-    def say(fraction: float, message: str):
-        latest[:] = [fraction, message]
-
-    task = asyncio.ensure_future(asyncio.to_thread(work, say))
-    shown = None
-    while not task.done():
-        await asyncio.wait({task}, timeout=PROGRESS_POLL_S)
-        if show is not None and latest and latest != shown and latest[0] < 1.0 and not task.done() and page_open(doc):
-            shown = list(latest)
-            show(float(np.clip(shown[0], 0.0, 1.0)), str(shown[1]))
+    task, task_id = _submit(work, latest)
+    try:
+        shown = None
+        while not task.done():
+            await asyncio.wait({task}, timeout=PROGRESS_POLL_S)
+            if (show is not None and latest and latest != shown and latest[0] < 1.0 and not task.done()
+                    and page_open(doc)):
+                shown = list(latest)
+                show(float(np.clip(shown[0], 0.0, 1.0)), str(shown[1]))
+    finally:
+        _progress.pop(task_id, None)
     if not page_open(doc):
         task.exception()  # retrieved: an error of work whose page has gone is nobody's
         raise PageClosed
-    return task.result()
+    try:
+        return task.result()
+    except BrokenProcessPool:
+        pool = _pool
+        if pool is not None:
+            _reset_broken(pool)
+        raise RuntimeError("its worker process stopped (out of memory?); try again") from None

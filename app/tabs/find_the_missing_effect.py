@@ -126,8 +126,8 @@ class DiagnosisView(pn.viewable.Viewer):
             return
         state.param.update(running=True, message="", result=None, revealed=False, progress=0.0,
                            progress_message="fitting the baseline")
-        try:
-            result = await in_thread(state.compute, self._show_progress, pn.state.curdoc)
+        try:  # in a worker process when the server has them (app.work.use_processes)
+            result = await in_thread(state.task(), self._show_progress, pn.state.curdoc)
         except PageClosed:
             return  # nothing is written to a closed page's document, not even "running" ended
         except (ValueError, ConvergenceError) as exc:

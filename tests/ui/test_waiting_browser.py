@@ -71,21 +71,27 @@ def gated_diagnosis(monkeypatch):
     say so: ``(reached, release)`` events (a fast machine may otherwise pass every candidate
     between two of the page's progress polls)."""
     from app.diagnosis_state import DiagnosisState
+    from app.work import Task
 
     reached, release = threading.Event(), threading.Event()
-    compute = DiagnosisState.compute
+    task = DiagnosisState.task
 
-    def gated(self, progress=None):
-        def say(fraction, message):
-            if progress is not None:
-                progress(fraction, message)
-            if message.startswith("step 1, candidate 2 of "):
-                reached.set()
-                release.wait(60)
+    def gated(self):
+        work = task(self)
 
-        return compute(self, say)
+        def run(*args, progress=None, **kwargs):
+            def say(fraction, message):
+                if progress is not None:
+                    progress(fraction, message)
+                if message.startswith("step 1, candidate 2 of "):
+                    reached.set()
+                    release.wait(60)
 
-    monkeypatch.setattr(DiagnosisState, "compute", gated)
+            return work.function(*args, progress=say, **kwargs)
+
+        return Task(run, work.args, work.kwargs)
+
+    monkeypatch.setattr(DiagnosisState, "task", gated)
     return reached, release
 
 
@@ -109,6 +115,32 @@ def test_the_diagnosis_shows_its_progress_until_its_report_replaces_it(page, exp
     assert not seen["progressWithReport"]
     assert len(seen["progress"]) >= 2, seen["progress"]  # the steps reached the page as they came
     assert any(re.search(r"candidate \d+ of \d+: ", p) for p in seen["progress"]), seen["progress"]
+    expect(page.locator(".diagnosis-progress")).to_have_count(0)
+
+
+@pytest.fixture
+def processes():
+    """Long work in a worker process, as ``bushing serve`` runs it (app.work.use_processes)."""
+    from app import work
+
+    work.use_processes(1)
+    yield work
+    work.stop_processes()
+
+
+def test_a_served_explorer_diagnoses_in_a_worker_process(page, explorer_url, tmp_path, processes):
+    """With worker processes on (``bushing serve``), the diagnosis runs in one: its progress
+    reaches the page through the workers' queue, and the report replaces it (never "done…"
+    alone, never the report with the progress still shown)."""
+    before = processes.relayed
+    open_explorer(page, explorer_url)
+    upload_150_points(page, tmp_path)
+    watch(page, r"(fitting|trying|candidate \d+ of \d+|profiling|checking|describing)[^…]*…", "What is left is noise")
+    page.get_by_role("button", name="Diagnose").click()
+    seen = wait_report(page)
+    assert not seen["doneAlone"] and not seen["progressWithReport"], seen["progress"]
+    assert seen["progress"], "no progress shown"
+    assert processes.relayed > before  # the steps came from the worker process
     expect(page.locator(".diagnosis-progress")).to_have_count(0)
 
 

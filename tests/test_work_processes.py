@@ -1,0 +1,67 @@
+"""Long work in worker processes (app.work): a served explorer runs the diagnosis in a pool of
+worker processes, off the interpreter lock its pages' changes need. The process route gives the
+same result as the thread route, passes the work's progress on in order, raises the work's own
+errors, and falls back to a thread for work that is not a :class:`app.work.Task`."""
+
+import asyncio
+import os
+
+import numpy as np
+import pytest
+
+from app import work
+from core import PAPER_B
+from core.identify.diagnose import diagnose
+from core.synthetic import synthetic_stiffness
+
+
+@pytest.fixture
+def processes():
+    work.use_processes(1)
+    yield
+    work.stop_processes()
+
+
+def data():
+    hidden = PAPER_B.replace(effects={"inertia": {"mass": 0.5}})
+    return synthetic_stiffness(hidden, np.linspace(1, 100, 12), [0.04e-3, 0.17e-3], noise=0.005, seed=3)
+
+
+def pid_of(progress=None):
+    if progress is not None:
+        progress(0.5, "half way")
+    return os.getpid()
+
+
+def refuse(progress=None):
+    raise ValueError("the data hold no axial rows")
+
+
+def run(task, shown=None):
+    return asyncio.run(work.in_thread(task, None if shown is None else lambda f, m: shown.append((f, m))))
+
+
+def test_a_task_runs_in_another_process_and_a_plain_function_in_this_one(processes):
+    assert run(work.Task(pid_of)) != os.getpid()
+    assert run(pid_of) == os.getpid()
+
+
+def test_the_diagnosis_in_a_worker_process_is_the_diagnosis_here(processes):
+    task = work.Task(diagnose, (PAPER_B, data()), {"baseline": ["elastic", "fractional", "friction"]})
+    shown, before = [], work.relayed
+    there = run(task, shown)
+    here = task()
+    assert [s.effect for s in there.steps] == [s.effect for s in here.steps] == ["inertia"]
+    np.testing.assert_allclose(there.final.gap, here.final.gap, rtol=1e-12)
+    assert work.relayed > before  # its progress came back through the queue
+    fractions = [f for f, _ in shown]
+    assert fractions == sorted(fractions) and all(0.0 <= f < 1.0 for f in fractions)
+
+
+def test_an_error_in_a_worker_is_the_works_own(processes):
+    with pytest.raises(ValueError, match="no axial rows"):
+        run(work.Task(refuse))
+
+
+def test_without_processes_a_task_runs_in_a_thread():
+    assert run(work.Task(pid_of)) == os.getpid()
