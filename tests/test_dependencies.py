@@ -90,3 +90,25 @@ def test_fmpy_the_fmus_checks_use_is_a_test_extra_under_bsd_2_clause():
         return  # not installed here: nothing more to read
     texts = [f.read_text() for f in dist.files or [] if "licen" in str(f).lower()]
     assert any("2-Clause BSD" in t for t in texts)
+
+
+def test_exudyn_the_examples_engine_is_an_extra_under_bsd_3_clauses_conditions():
+    """Exudyn (examples/exudyn_bushing.py) is the `exudyn` extra, which the test extra pulls in,
+    never a run-time dependency; its metadata names the "EXUDYN General License", whose text
+    carries BSD-3-Clause's three conditions."""
+    from importlib import metadata
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    extras = project["optional-dependencies"]
+    assert not any(d.lower().startswith("exudyn") for d in project["dependencies"])
+    assert any(d.lower().startswith("exudyn") for d in extras["exudyn"])
+    assert "bushing-explorer[exudyn]" in extras["test"]
+    try:
+        dist = metadata.distribution("exudyn")
+    except metadata.PackageNotFoundError:
+        return  # not installed here: nothing more to read
+    texts = [" ".join(f.read_text().split()) for f in dist.files or [] if "licen" in str(f).lower()]
+    assert any(t.startswith("EXUDYN General License")
+               and "Redistributions of source code must retain the above copyright notice" in t
+               and "Neither the name of the copyright holders nor the names of its contributors may be used" in t
+               for t in texts)

@@ -25,7 +25,8 @@ OTHER_PARTS = {
     "tests/": "the pytest suite; `tests/ui/` drives the explorer in Chromium",
     "benchmarks/": "speed and memory scripts (they print figures and ratios; no assertions)",
     "examples/": "synthetic example data (made from the model, with stated noise), the script that "
-                 "makes them and a notebook of the plotting API",
+                 "makes them, a notebook of the plotting API and the bushing element in Exudyn "
+                 "(`exudyn_bushing.py`)",
     "tools/": "maintenance scripts: the finite-length shape-factor table, this section, the screenshots "
               "of every tab (`tools/screenshots.py --out DIR --sizes 1280x720,1600x1000`)",
     "deploy/": "the nginx configuration template for several server processes behind one address",
