@@ -302,7 +302,7 @@ def _cmd_fmu(args) -> None:
     design = read_design(args.design)
     try:
         result = write_fmu(coefficients(design, slices=args.slices, band=(f1, f2)), out,
-                           model_name=design.name or out.stem, band=(f1, f2))
+                           model_name=design.name or out.stem)
     except FmuError as exc:
         raise InputError(f"bushing fmu: {exc}")
     if result.note:
