@@ -18,8 +18,7 @@ import pytest
 
 from core import PAPER_B
 from core.bushing import stiffness
-from core.element import CHANNEL_MODES, CHANNELS, OUTPUTS, Element, coefficients
-from core.element.element import HELD_LIMIT
+from core.element import CHANNEL_MODES, CHANNELS, OUTPUTS, coefficients
 from fmu import write_fmu
 from tests.fmu_helpers import equivalent_amplitude, first_harmonic
 
@@ -93,19 +92,6 @@ def test_fmpy_validation_finds_nothing_and_the_description_is_complete(built):
     xml = ET.parse(unzipped / "modelDescription.xml").getroot()
     listed = [f.get("name") for f in xml.iter("File")]
     assert listed and all((unzipped / "sources" / f).is_file() for f in listed)
-
-
-def test_the_default_step_is_the_longest_the_held_input_allows(built):
-    """The default experiment's step keeps the held input's error in the fractional term under
-    the element's own warning threshold over the band (Element.held_error); 1.5 times it does not."""
-    result, _, co = built
-    h = float(fmpy.read_model_description(str(result.path)).defaultExperiment.stepSize)
-    element = Element(co)
-    mag, phase = element.held_error(h)
-    assert mag <= HELD_LIMIT[0] and phase <= HELD_LIMIT[1]
-    mag, phase = element.held_error(1.5 * h)
-    assert mag > HELD_LIMIT[0] or phase > HELD_LIMIT[1]
-    assert 1 / (1000 * co.band[1]) < h < 1 / (100 * co.band[1])  # docs/fmu.md: about 1/(300 f₂) at α = 0.2
 
 
 def test_the_binary_needs_no_python_only_libc_and_libm(built):
