@@ -61,6 +61,7 @@ def test_without_a_compiler_it_writes_the_source_only_fmu_and_says_so(design, tm
 @pytest.mark.parametrize(("args", "words"), [
     (["--slices", 0], "--slices must be at least 1"),
     (["--slices", 1001], "--slices must be at most 1000"),
+    (["--slices", 101], "bushing fmu: slices: must be a whole number from 1 to 100"),  # the element's limit
     (["--slices", 2.5], "--slices must be a whole number"),
     (["--band", 100, 10], "the lower frequency must be below the upper one"),
     (["--band", 10, 10], "the lower frequency must be below the upper one"),
@@ -94,6 +95,14 @@ def test_an_unwritable_output_is_one_line_and_status_2(design, tmp_path, capsys)
             assert status == 2 and err.count("\n") == 1 and "cannot write" in err
     finally:
         locked.chmod(0o700)
+
+
+def test_an_effect_without_a_time_domain_form_is_one_line_and_status_2(tmp_path, capsys):
+    path = tmp_path / "rig.json"
+    write_design(PAPER_B.replace(effects={"inertia": {"mass": 1.0}}), path)
+    status, _, err = run(["fmu", path, "-o", tmp_path / "b.fmu"], capsys)
+    assert status == 2 and err.count("\n") == 1 and err.startswith("bushing fmu: effects.inertia: the time-domain")
+    assert not (tmp_path / "b.fmu").exists()
 
 
 def test_design_file_errors_are_one_line_and_status_2(tmp_path, capsys):
