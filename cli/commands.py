@@ -301,9 +301,9 @@ def _cmd_fmu(args) -> None:
                          + ("it is a directory" if out.is_dir() else "its directory does not exist"))
     design = read_design(args.design)
     try:
-        result = write_fmu(coefficients(design, slices=args.slices, band=(f1, f2)), out,
-                           model_name=design.name or out.stem, band=(f1, f2))
-    except FmuError as exc:
+        co = coefficients(design, slices=args.slices, band=(f1, f2))  # the element's rules: slices, effects
+        result = write_fmu(co, out, model_name=design.name or out.stem)
+    except (FmuError, ValueError) as exc:
         raise InputError(f"bushing fmu: {exc}")
     if result.note:
         sys.stderr.write(f"bushing fmu: {result.note}\n")

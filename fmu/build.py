@@ -21,12 +21,11 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
-from .description import model_description, parameters, resource_text
+from .description import default_step, model_description, parameters, resource_text
 
 SOURCES = ("bushing_kernel.c", "bushing_resource.c", "bushing_fmu.c", "bushing_state.c")
 HEADERS = ("bushing_kernel.h", "bushing_resource.h", "bushing_fmu.h")
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
-DEFAULT_BAND = (0.1, 2000.0)  # Hz: docs/element.md
 TOOL = "bushing-explorer (bushing fmu)"
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden")
 
@@ -85,21 +84,21 @@ def compile_binary(compiler: str, out: Path) -> str | None:
     return None
 
 
-def write_fmu(coefficients, path, *, model_name: str | None = None, band=DEFAULT_BAND,
-              description: str | None = None, compiler: str | None | bool = True) -> FmuResult:
+def write_fmu(coefficients, path, *, model_name: str | None = None, description: str | None = None,
+              compiler: str | None | bool = True) -> FmuResult:
     """Write the FMU of a bushing element's coefficients.
 
     Parameters
     ----------
-    coefficients : mapping or object with ``as_dict()``
-        The element's coefficients (:func:`fmu.description.parameters`, the seam with
-        ``core.element.coefficients``), SI.
+    coefficients : core.element.Coefficients
+        The element's coefficients (:func:`core.element.coefficients`), SI: the FMU's parameters
+        (:meth:`~core.element.Coefficients.parameters`) and, from its band and the held input's
+        error, the default experiment's step (:func:`fmu.description.default_step`).
     path : str or pathlib.Path
-        The ``.fmu`` file to write (replaced if it exists).
+        The ``.fmu`` file to write (replaced if it exists), with the permissions of a new file
+        (0666 less the umask).
     model_name : str, optional
         The model's name in ``modelDescription.xml`` (default: the file's stem).
-    band : (float, float), default (0.1, 2000.0)
-        The band in Hz the exponentials were fitted over: the default step is 1/(400 f₂).
     description : str, optional
         A sentence for ``modelDescription.xml``.
     compiler : str, True or None
@@ -126,7 +125,7 @@ def write_fmu(coefficients, path, *, model_name: str | None = None, band=DEFAULT
     files = {
         "modelDescription.xml": model_description(
             params, model_identifier=ident, model_name=model_name or path.stem, guid=guid,
-            band=(float(band[0]), float(band[1])), source_files=SOURCES, generation_tool=TOOL,
+            step=default_step(coefficients), source_files=SOURCES, generation_tool=TOOL,
             description=description or "A rubber bushing with frequency- and amplitude-dependent "
                                        "stiffness (Bushing Explorer's time-domain element)").encode(),
         "resources/coefficients.txt": resource_text(params, sizes, guid).encode(),
@@ -156,8 +155,16 @@ def write_fmu(coefficients, path, *, model_name: str | None = None, band=DEFAULT
     return FmuResult(path, binary, note)
 
 
+def _umask() -> int:
+    """The process's umask (read by setting it and setting it back)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 def _write_zip(path: Path, files: dict[str, bytes]) -> None:
-    """The archive written beside its destination and moved over it: never half a file."""
+    """The archive written beside its destination and moved over it: never half a file. It gets
+    a new file's usual permissions, 0666 less the umask (a temporary file is 0600)."""
     try:
         fd, tmp = tempfile.mkstemp(prefix=".fmu-", suffix=".tmp", dir=path.parent)
     except OSError as exc:
@@ -166,6 +173,7 @@ def _write_zip(path: Path, files: dict[str, bytes]) -> None:
         with os.fdopen(fd, "wb") as raw, zipfile.ZipFile(raw, "w", zipfile.ZIP_DEFLATED) as zf:
             for name, data in files.items():
                 zf.writestr(name, data)
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     except OSError as exc:
         Path(tmp).unlink(missing_ok=True)

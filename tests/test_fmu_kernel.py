@@ -12,8 +12,8 @@ import pytest
 from scipy.optimize import brentq
 
 from core import PAPER_B
-from fmu.description import CHANNELS
-from tests.fmu_helpers import Kernel, coefficients_of, compile_kernel
+from core.element import CHANNELS, coefficients
+from tests.fmu_helpers import Kernel, compile_kernel
 
 pytestmark = pytest.mark.skipif(shutil.which("cc") is None, reason="needs a C compiler (README's test command)")
 
@@ -23,11 +23,20 @@ def library(tmp_path_factory):
     return compile_kernel(tmp_path_factory.mktemp("kernel"))
 
 
-def rich_coefficients():
-    """Every term at work: 2 slices axially and in torsion, a bulk spring, stiffening, viscosity."""
-    co = coefficients_of(PAPER_B, 2, count=12, beta=40.0, viscosity=30.0)
-    co["dz"]["compliance"] = 0.3 / (PAPER_B.shape_factor * PAPER_B.material.shear_modulus)
-    co["dx"]["compliance"] = 0.2 / (PAPER_B.in_mode("radial").shape_factor * PAPER_B.material.shear_modulus)
+EFFECTS = {"strain_stiffening": {"stiffening": 40.0}, "viscous": {"viscosity": 30.0}}
+# every term at work between them, with strain stiffening and viscosity in both: 2 slices axially
+# and in torsion (long shape factors); a bulk spring in series in five channels (finite shape)
+RICH = {"2 slices": (PAPER_B.replace(effects=EFFECTS), 2),
+        "a bulk spring": (PAPER_B.replace(shape="finite", bulk_modulus=2.0e8, effects=EFFECTS), 1)}
+
+
+def rich_coefficients(name="2 slices"):
+    design, slices = RICH[name]
+    co = coefficients(design, slices)
+    layered = [ch for ch, c in co.channels.items() if len(c.S) > 1]
+    springs = [ch for ch, c in co.channels.items() if c.compliance > 0]
+    assert co.beta > 0 and co.viscosity > 0 and co.rate
+    assert layered == ["dz", "rz"] if slices > 1 else len(springs) == 5
     return co
 
 
@@ -45,12 +54,12 @@ class Reference:
 
     def __init__(self, co):
         self.co = co
-        self.rate, self.weight = np.array(co["rate"]), np.array(co["weight"])
-        self.layers = {ch: [Layer(self.rate.size) for _ in co[ch]["S"]] for ch in CHANNELS}
+        self.rate, self.weight = np.array(co.rate), np.array(co.weight)
+        self.layers = {ch: [Layer(self.rate.size) for _ in co.channels[ch].S] for ch in CHANNELS}
 
     def friction(self, layer, e):
         co = self.co
-        smax, half = co["sigma_f_max"], co["eps_half"]
+        smax, half = co.sigma_f_max, co.eps_half
         if e == layer.eps:
             return layer.sig_f, layer.dir, layer.eps_s, layer.sig_s
         s = 1.0 if e > layer.eps else -1.0
@@ -62,8 +71,8 @@ class Reference:
     def stress(self, layer, e, h):
         co = self.co
         z = np.exp(-self.rate * h) * (layer.z + e - layer.eps)
-        return (2 * co["mu"] * e * (1 + co["beta"] * e * e) + co["m"] * np.dot(self.weight, z)
-                + co["viscosity"] * (e - layer.eps) / h + self.friction(layer, e)[0])
+        return (2 * co.mu * e * (1 + co.beta * e * e) + co.m * np.dot(self.weight, z)
+                + co.viscosity * (e - layer.eps) / h + self.friction(layer, e)[0])
 
     def strain(self, layer, target, h):
         def f(e):
@@ -77,8 +86,8 @@ class Reference:
     def step(self, x, h):
         out = []
         for ch, xc in zip(CHANNELS, x, strict=True):
-            layers, s, c = self.layers[ch], self.co[ch]["S"], self.co[ch]["c"]
-            cb = self.co[ch]["compliance"]
+            layers, s, c = self.layers[ch], self.co.channels[ch].S, self.co.channels[ch].c
+            cb = self.co.channels[ch].compliance
             if len(layers) == 1 and cb == 0:
                 strains = [c[0] * xc]
                 load = self.stress(layers[0], strains[0], h) * s[0] / (2 * c[0])
@@ -113,8 +122,9 @@ def history(n, seed=3):
     return np.diff(np.concatenate(([0.0], t))), x
 
 
-def test_the_kernel_matches_the_reference_of_the_spec_along_one_history(library):
-    co = rich_coefficients()
+@pytest.mark.parametrize("name", RICH)
+def test_the_kernel_matches_the_reference_of_the_spec_along_one_history(library, name):
+    co = rich_coefficients(name)
     kernel, reference = Kernel(library, co), Reference(co)
     steps, drive = history(120)
     worst = 0.0
@@ -142,7 +152,7 @@ def test_a_trial_leaves_the_state_and_gives_what_the_commit_gives(library):
 def test_the_work_per_step_does_not_grow_with_the_history(library):
     """Layer-law evaluations per step (a count, not a time) early and late in a long
     stationary drive; the state's size is fixed by construction."""
-    kernel = Kernel(library, coefficients_of(PAPER_B, 3))
+    kernel = Kernel(library, coefficients(PAPER_B, 3))
     n, block = 20_000, 2_000
     t = np.arange(1, n + 1) * 2e-4
     amp = np.array([2e-4, 2e-4, 1e-4, 4e-3, 4e-3, 4e-3])
@@ -158,6 +168,6 @@ def test_the_work_per_step_does_not_grow_with_the_history(library):
 
 
 def test_a_nan_input_is_an_error_with_a_sentence_not_a_number(library):
-    kernel = Kernel(library, coefficients_of(PAPER_B, 1))
+    kernel = Kernel(library, coefficients(PAPER_B, 1))
     with pytest.raises(RuntimeError, match="input rx = nan: must be a finite number"):
         kernel.step([0, 0, 0, np.nan, 0, 0], 1e-4)

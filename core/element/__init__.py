@@ -14,6 +14,7 @@ from .coefficients import (
     OUTPUTS,
     ChannelCoefficients,
     Coefficients,
+    Parameter,
     coefficients,
 )
 from .element import Element, ElementWarning
@@ -28,6 +29,7 @@ __all__ = [
     "Coefficients",
     "Element",
     "ElementWarning",
+    "Parameter",
     "PronyFit",
     "check_band",
     "coefficients",

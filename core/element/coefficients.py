@@ -18,6 +18,7 @@ in series with the compliance C_b = g/(S₀ K). The long radial closed form
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from ..bushing import STRUCTURAL_EFFECTS
 from ..design import Design
@@ -38,6 +39,28 @@ REFUSED_EFFECTS = {
     "inertia": "it is a test rig's apparent mass, not the bushing's",
 }
 assert set(STRUCTURAL_EFFECTS) <= set(REFUSED_EFFECTS)
+
+
+# the material scalars: (name, unit, description), in the C kernel's order (enum BK_MU …
+# BK_VISCOSITY in fmu/c/bushing_kernel.h); "alpha" in a unit stands for α's value
+SCALARS = (
+    ("mu", "Pa", "µ, the elastic branch's shear modulus"),
+    ("m", "Pa.s^alpha", "m, the fractional branch's coefficient"),
+    ("alpha", "1", "α, the fractional order (for reading: the weights carry it)"),
+    ("sigma_f_max", "Pa", "σ_fmax, the friction stress limit (0: no friction)"),
+    ("eps_half", "1", "ε½, the friction half strain"),
+    ("beta", "1", "β, strain stiffening in 2µε(1 + βε²) (0: none)"),
+    ("viscosity", "Pa.s", "c_v, the viscous coefficient (0: none)"),
+)
+
+
+class Parameter(NamedTuple):
+    """One coefficient as the FMU carries it: its name, value (SI), unit and a sentence."""
+
+    name: str
+    value: float
+    unit: str
+    description: str
 
 
 @dataclass(frozen=True)
@@ -136,19 +159,31 @@ class Coefficients:
             "sliced_channels": list(self.sliced_channels),
         }
 
-    def parameters(self) -> list[tuple[str, float, str]]:
-        """The coefficients as (name, value, unit) in docs/element.md's table's order and names
-        (``rate[0]``, ``dz.S[2]``, ``dx.compliance``…): what the FMU's parameters are."""
-        rows = [("mu", self.mu, "Pa"), ("m", self.m, "Pa·s^α"), ("alpha", self.alpha, "–"),
-                ("sigma_f_max", self.sigma_f_max, "Pa"), ("eps_half", self.eps_half, "–"),
-                ("beta", self.beta, "–"), ("viscosity", self.viscosity, "Pa·s")]
-        rows += [(f"rate[{j}]", v, "1/s") for j, v in enumerate(self.rate)]
-        rows += [(f"weight[{j}]", v, "s^−α") for j, v in enumerate(self.weight)]
+    def parameters(self) -> list[Parameter]:
+        """The coefficients as :class:`Parameter` rows (name, value, unit, description): THE one
+        list of their names, units and order (docs/element.md's table), which the FMU's
+        ``modelDescription.xml`` carries as its parameters and its C kernel reads in this order.
+
+        Order: the scalars ``mu`` … ``viscosity``, ``rate[1…J]``, ``weight[1…J]``, then per
+        channel (``dx`` … ``rz``) ``S[1…N]``, ``c[1…N]``, ``compliance``. Indices count from 1
+        (FMI's structured names). Units are SI names in ASCII, ``.`` a product (``N.m``), ``1``
+        dimensionless; the fractional ones carry α's value (``Pa.s^0.2``, ``s^-0.2``)."""
+        a = f"{self.alpha:.6g}"
+        rows = [Parameter(name, getattr(self, name), unit.replace("^alpha", "" if a == "1" else f"^{a}"), text)
+                for name, unit, text in SCALARS]
+        rows += [Parameter(f"rate[{j}]", v, "1/s", f"λ_{j}, the rate of exponential {j}")
+                 for j, v in enumerate(self.rate, 1)]
+        rows += [Parameter(f"weight[{j}]", v, f"s^-{a}", f"g_{j}, the weight of exponential {j}")
+                 for j, v in enumerate(self.weight, 1)]
         for name, ch in self.channels.items():
-            rotation = MODE[ch.mode].rotation
-            rows += [(f"{name}.S[{k}]", v, "m³/rad" if rotation else "m") for k, v in enumerate(ch.S)]
-            rows += [(f"{name}.c[{k}]", v, "1/rad" if rotation else "1/m") for k, v in enumerate(ch.c)]
-            rows.append((f"{name}.compliance", ch.compliance, "rad/(N·m)" if rotation else "m/N"))
+            turn = MODE[ch.mode].rotation
+            what = f"{ch.mode} channel {name}"
+            rows += [Parameter(f"{name}.S[{k}]", v, "m3/rad" if turn else "m", f"{what}: layer {k}'s shape factor")
+                     for k, v in enumerate(ch.S, 1)]
+            rows += [Parameter(f"{name}.c[{k}]", v, "1/rad" if turn else "1/m", f"{what}: layer {k}'s strain factor")
+                     for k, v in enumerate(ch.c, 1)]
+            rows.append(Parameter(f"{name}.compliance", ch.compliance, "rad/(N.m)" if turn else "m/N",
+                                  f"{what}: the series bulk compliance C_b (0: none)"))
         return rows
 
 
