@@ -8,6 +8,7 @@ import math
 
 from core.bushing import MAX_SLICES, ROUTES
 from core.element import DEFAULT_BAND
+from core.element.coefficients import MAX_SLICES as ELEMENT_SLICES
 from core.element.prony import MAX_DECADES as MAX_BAND_DECADES
 from core.io.export import FORMATS
 from core.parameters import BRANCH_PARAMETERS, MODE, ROTATIONS, TRANSLATIONS
@@ -215,8 +216,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     fm.add_argument("design", metavar="DESIGN.json", help="design file (docs/files.md); its mode is not used")
     fm.add_argument("-o", dest="output", required=True, metavar="BUSHING.fmu", help="the FMU to write")
-    fm.add_argument("--slices", type=_count("--slices", maximum=MAX_SLICES), default=1, metavar="N",
-                    help=f"N slices in series in the axial and torsion channels (default 1, at most {MAX_SLICES})")
+    fm.add_argument("--slices", type=_count("--slices", maximum=ELEMENT_SLICES), default=1, metavar="N",
+                    help=f"N slices in series in the axial and torsion channels (default 1, at most {ELEMENT_SLICES})")
     fm.add_argument("--band", nargs=2, type=_positive("--band"), default=FMU_BAND, metavar=("F1", "F2"),
                     help=f"the band in Hz the fractional derivative is fitted over (default {FMU_BAND[0]:g} "
                          f"{FMU_BAND[1]:g}, at most {MAX_BAND_DECADES} decades wide)")
