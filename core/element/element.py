@@ -31,6 +31,18 @@ _H_CACHE = 64  # step lengths remembered (e^{−λh} per h)
 HELD_LIMIT = (0.01, 0.01)  # relative magnitude, phase (rad): the fractional term's error that warns
 
 
+def bracketed(new, step, lo, hi):
+    """Newton's next force ``new`` (``step`` from the last) kept inside the bracket (lo, hi) of
+    each channel: bisection where both ends are known, else 2|step| away from the known end."""
+    outside = (new <= lo) | (new >= hi)
+    if not outside.any():
+        return new
+    lo_known, hi_known = np.isfinite(lo), np.isfinite(hi)
+    safe = np.where(lo_known & hi_known, 0.5 * (np.where(lo_known, lo, 0.0) + np.where(hi_known, hi, 0.0)),
+                    np.where(lo_known, lo + 2.0 * np.abs(step), hi - 2.0 * np.abs(step)))
+    return np.where(outside, safe, new)
+
+
 class ElementWarning(UserWarning):
     """A step too long for the band: with the input held over it, the fractional term is more than
     :data:`HELD_LIMIT` off (iω)^α somewhere in the band (:meth:`Element.held_error`)."""
@@ -287,9 +299,8 @@ class Element:
                 lo = np.max(np.where(gs < 0, fs, -np.inf), axis=0)
                 hi = np.min(np.where(gs > 0, fs, np.inf), axis=0)
                 bracket = lo, hi
-                outside = (new <= lo) | (new >= hi)
-                new = np.where(outside, 0.5 * (lo + hi), new)  # both sides known where outside
-            f = new
+                new = bracketed(new, step, lo, hi)
+            f = np.where(done, f, new)  # a channel that has converged stays where it is
         bad = int(np.argmax(np.abs(g) / tol))
         raise ConvergenceError(
             f"element: the series solve of channel {self.channels[ch[bad]]} did not converge in {MAX_ITER} "
