@@ -289,11 +289,13 @@ class Element:
         rows = list(zip(law, p, inv_c, strict=True))
         on_branch, ratio = layers.on_branch, half / smax
         g = size = math.nan
+        last_small = math.inf
         for it in range(1, MAX_ITER + 1):
             g, dg = compliance * f - x, compliance
-            size = abs(x) + abs(compliance * f)  # the size of the equation's terms: its rounding
+            size = abs(x) + abs(compliance * f)  # the size of the equation's terms: their rounding
             for i, ((b, kink, o), pk, ik) in enumerate(rows):
                 tau = pk * f
+                origin_eps = o[0] if tau > kink else o[2]
                 if k3:
                     e, sl = layers.strain(tau, a, b, kink, o, smax, half, k3)
                 elif tau > kink:  # layers.strain without stiffening, inline: the hot loop
@@ -302,7 +304,8 @@ class Element:
                     e, sl = on_branch(tau, a, b, o[2], o[3], -1.0, smax, ratio)
                 es[i], sls[i] = e, sl
                 g += e * ik
-                size += abs(e) * ik
+                # ε = ε_s + s v is as exact as the larger of |ε| and |ε_s| allows
+                size += (max(abs(origin_eps), abs(e))) * ik
                 dg += pk * ik / sl
             if not (math.isfinite(g) and math.isfinite(dg)):
                 break
@@ -323,12 +326,16 @@ class Element:
                 lo = f
             else:
                 hi = f
-            if not lo < new < hi:  # Newton left the bracket (a friction kink): bisect
-                if math.isinf(lo) or math.isinf(hi):
-                    break  # the step moved F by less than its resolution
+            inside = lo < new < hi
+            if not inside and (math.isinf(lo) or math.isinf(hi)):
+                break  # the step moved F by less than its resolution
+            # bisect where Newton leaves the bracket (a friction kink) or stops halving the
+            # residual (it can cycle across an inflection of strong stiffening)
+            if not inside or (small > 0.5 * last_small and not (math.isinf(lo) or math.isinf(hi))):
                 new = 0.5 * (lo + hi)
                 if new in (lo, hi):  # a bracket as narrow as the floats allow
                     break
+            last_small = small
             f = new
         else:
             raise ConvergenceError(
