@@ -85,9 +85,13 @@ class Element:
         ends = self._nd + np.cumsum([len(chs[i].S) for i in self._series_ch])
         self._series = [(int(i), int(e - len(chs[i].S)), int(e), float(compliance[i]))
                         for i, e in zip(self._series_ch, ends, strict=True)]
+        # per series channel, per layer: (p_k, 1/c_k, p_k/c_k)
+        self._series_layers = [tuple((self._p[j], self._inv_c[j], self._p[j] * self._inv_c[j]) for j in range(first, end))
+                               for _, first, end, _ in self._series]
         self._rates = np.array(co.rate)
         self._weights = np.array(co.weight)
         self._mat = (co.mu, co.beta, co.sigma_f_max, co.eps_half)
+        self._k3 = 2.0 * co.mu * co.beta  # Pa: the cubic's coefficient 2µβ
         self._h_cache: dict[float, tuple] = {}
         self._warned: set[float] = set()
         self.iterations = 0  # Newton iterations of the last step's series solve (the most of its channels)
@@ -257,56 +261,56 @@ class Element:
         self.iterations = 0
         if self._series:
             tangent, slope = list(tangent), list(slope)
-            for ch, first, end, comp in self._series:
-                law = [(b[j], stress(last[j], a, b[j], sigf[j], k3), origin[j]) for j in range(first, end)]
-                f, dxdf = self._solve(ch, first, xs[ch], comp, a, law, eps, slope)
+            for (ch, first, end, comp), static in zip(self._series, self._series_layers, strict=True):
+                law = [(pk, ik, pik, b[j], stress(last[j], a, b[j], sigf[j], k3), origin[j], slope[j])
+                       for j, (pk, ik, pik) in zip(range(first, end), static, strict=True)]
+                f, dxdf, eps[first:end], slope[first:end] = self._solve(ch, xs[ch], comp, a, law)
                 force[ch], tangent[ch] = f, 1.0 / dxdf
                 for j in range(first, end):
                     sf[j] = friction(eps[j], last[j], sigf[j], origin[j], smax, ratio)
         return force, eps, sf, tangent, slope, xs, decay
 
-    def _solve(self, ch, first, x, compliance, a, law, eps, slope):
+    def _solve(self, ch, x, compliance, a, law):
         """Newton on one series channel's force F (N or N·m), with a bracket: Σ ε_k(p_k F)/c_k +
-        C_b F = x; ``law`` holds each layer's (b, kink, branch origins) of
-        :func:`core.element.layers.strain`. Writes the layers' strains and slopes dσ/dε into
-        ``eps`` and ``slope`` (from index ``first``); returns (F, dx/dF)."""
+        C_b F = x; ``law`` holds each layer's (p_k, 1/c_k, p_k/c_k, b, kink, branch origins, last
+        slope) of :func:`core.element.layers.strain`. Returns (F, dx/dF, the layers' strains, their
+        slopes dσ/dε)."""
         s = self._s
-        n = len(law)
-        p = self._p[first:first + n]
-        inv_c = self._inv_c[first:first + n]
-        kinks = [lk[1] for lk in law]
         _, _, smax, half = self._mat
-        k3 = 2.0 * self._mat[0] * self._mat[1]
+        k3 = self._k3
+        ratio = half / smax
+        on_branch = layers.on_branch
         f_last = s["force"][ch]
         # predictor: the last tangent, with the layers' stress at their committed strains under
         # this step's memory (the relaxation since the last step) moved along their last slopes
         relax = 0.0
-        for kink, pk, ik, sl in zip(kinks, p, inv_c, slope[first:first + n], strict=True):
+        for pk, ik, _, _, kink, _, sl in law:
             relax += ik * (kink - f_last * pk) / sl
         f = f_last + s["tangent"][ch] * (x - s["x"][ch] + relax)
         lo, hi = -math.inf, math.inf
-        es, sls = [0.0] * n, [0.0] * n
-        rows = list(zip(law, p, inv_c, strict=True))
-        on_branch, ratio = layers.on_branch, half / smax
         g = size = math.nan
         last_small = math.inf
         for it in range(1, MAX_ITER + 1):
             g, dg = compliance * f - x, compliance
             size = abs(x) + abs(compliance * f)  # the size of the equation's terms: their rounding
-            for i, ((b, kink, o), pk, ik) in enumerate(rows):
+            es, sls = [], []
+            for pk, ik, pik, b, kink, o, _ in law:
                 tau = pk * f
-                origin_eps = o[0] if tau > kink else o[2]
                 if k3:
                     e, sl = layers.strain(tau, a, b, kink, o, smax, half, k3)
+                    origin_eps = o[0] if tau > kink else o[2]
                 elif tau > kink:  # layers.strain without stiffening, inline: the hot loop
                     e, sl = on_branch(tau, a, b, o[0], o[1], 1.0, smax, ratio)
+                    origin_eps = o[0]
                 else:
                     e, sl = on_branch(tau, a, b, o[2], o[3], -1.0, smax, ratio)
-                es[i], sls[i] = e, sl
+                    origin_eps = o[2]
+                es.append(e)
+                sls.append(sl)
                 g += e * ik
                 # ε = ε_s + s v is as exact as the larger of |ε| and |ε_s| allows
-                size += (max(abs(origin_eps), abs(e))) * ik
-                dg += pk * ik / sl
+                size += max(abs(origin_eps), abs(e)) * ik
+                dg += pik / sl
             if not (math.isfinite(g) and math.isfinite(dg)):
                 break
             small = abs(g)
@@ -314,14 +318,17 @@ class Element:
             new = f + step
             if small <= TOLERANCE * size or new == f:
                 break
-            # close enough that Newton's next residual, ~ (G''/2) step², is far below the
-            # tolerance: take the step without another evaluation (the layers' strains along
-            # their tangents), unless a layer would cross its friction kink in it
-            if small <= LAST_STEP * size and all(
-                    (pk * f + pk * step > kink) == (pk * f > kink) for pk, kink in zip(p, kinks, strict=True)):
-                es = [e + pk * step / sl for e, pk, sl in zip(es, p, sls, strict=True)]
-                f = new
-                break
+            if small <= LAST_STEP * size:
+                # close enough that Newton's next residual, ~ (G''/2) step², is far below the
+                # tolerance: take the step without another evaluation (the layers' strains along
+                # their tangents), unless a layer would cross its friction kink in it
+                for pk, _, _, _, kink, _, _ in law:
+                    if (pk * f + pk * step > kink) != (pk * f > kink):
+                        break
+                else:
+                    es = [e + law_k[0] * step / sl for e, law_k, sl in zip(es, law, sls, strict=True)]
+                    f = new
+                    break
             if g < 0.0:
                 lo = f
             else:
@@ -345,6 +352,4 @@ class Element:
             raise ConvergenceError(f"element: the series solve of channel {self.channels[ch]} met a "
                                    f"non-finite force or strain (input {x:.6g})")
         self.iterations = max(self.iterations, it)
-        eps[first:first + n] = es
-        slope[first:first + n] = sls
-        return f, dg
+        return f, dg, es, sls
