@@ -1,14 +1,15 @@
 """The stateful time-domain element: six uncoupled channels, one step at a time, O(1) per step
 (docs/element.md).
 
-:class:`Element` keeps each layer's state as Python floats (the layers are few: NumPy's cost per
-call would dominate) and the exponentials' states as one array (layers × terms), so a step is
-two array operations and O(layers) float arithmetic whatever the history. A channel of one
-layer without a bulk spring needs no solve: its strain is c·x. A channel of layers in series
-(slices, or a bulk spring) solves for its force F by Newton's method on
+:class:`Element` keeps each layer's state as Python floats (the layers are few: NumPy's cost
+per call would dominate) and the exponentials' states as one array (layers × terms), so a step
+is a handful of array operations and O(layers) float arithmetic whatever the history. A
+channel of one layer without a bulk spring needs no solve: its strain is c·x. A channel of
+layers in series (slices, or a bulk spring) solves for its force F by Newton's method on
 Σ_k ε_k(p_k F)/c_k + C_b F = x, each layer's strain ε_k(τ) exact on its friction branch
-(:class:`core.element.layers.Layer`), safeguarded by a bracket on F (bisection where a friction
-kink throws Newton outside it), to 1e−13 of the size of the equation's terms.
+(:func:`core.element.layers.strain`), safeguarded by a bracket on F (bisection where a friction
+kink throws Newton outside it or Newton stops halving the residual), to 1e−13 of the size of
+the equation's terms.
 """
 
 from __future__ import annotations
