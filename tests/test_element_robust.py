@@ -1,6 +1,7 @@
 """The element under hostile but valid drives (docs/element.md, "A step"): it never returns a
-NaN and its series solve always converges, and the numbers are the C kernel's (an independent
-solve of the same equations: nested safeguarded Newton, fmu/c/bushing_kernel.c).
+NaN, its series solve always converges, its state after each step solves the step's equations
+(checked here from the states, independently of the solve), and the C kernel (nested
+safeguarded Newton, fmu/c/bushing_kernel.c) gives the same forces.
 
 The drives: strains up to the core's MAX_STRAIN, steps from 1e-9 s to 1 s, signs alternating at
 every step, inputs repeated exactly, all six channels at once; designs with slices, a bulk
