@@ -2,10 +2,11 @@
 
 A harmonic drive at 10 Hz, ε̂ = 1e-3 in every channel, 1000 steps a period, after one period of
 warm-up: CPU time (time.process_time, the least of 5 runs) per committed step, and the Newton iterations of the
-series solve. The aim (issue 30) is ≤ 30 µs per step with 3 slices. Every layer of every channel
-is one array, so the cost is a fixed number of NumPy operations (each about 0.5–1 µs on small
-arrays): nearly the same for 3 slices as for 10; the series solve's Newton iterations (about
-3 a step) are what costs.
+series solve. The aim (issue 30) is ≤ 30 µs per step with 3 slices. The layers' law runs on
+Python floats (NumPy's cost per call, about 1 µs, would dominate arrays of 6–30 layers): a
+step is a handful of array operations (the exponentials' states, the inputs and outputs) and
+O(layers) float arithmetic, so the cost grows with the layers of the sliced channels (axial
+and torsion) and with the series solve's evaluations (about 2 a step).
 
     PYTHONPATH=$PWD python benchmarks/element_speed.py
 """

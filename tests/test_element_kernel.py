@@ -12,7 +12,6 @@ import pytest
 
 from core import PAPER_B
 from core.element import CHANNELS, Element, coefficients
-from core.material import ConvergenceError
 from tests.fmu_helpers import Kernel, compile_kernel
 
 
@@ -43,15 +42,8 @@ DESIGNS = {
 }
 
 
-# known defect, found by this test: the Python element's series solve with a bulk spring stops
-# with a NaN residual in the radial channel of this history (the C kernel converges); strict,
-# so the mark must go when the solve is mended
-BULK_DEFECT = pytest.mark.xfail(strict=True, raises=ConvergenceError,
-                                reason="core.element: series solve with a bulk spring does not converge (dx)")
-
-
 @pytest.mark.filterwarnings("ignore::core.element.ElementWarning")  # the comparison, not the step's accuracy
-@pytest.mark.parametrize("name", [pytest.param(n, marks=BULK_DEFECT) if "bulk" in n else n for n in DESIGNS])
+@pytest.mark.parametrize("name", DESIGNS)
 def test_the_python_element_and_the_c_kernel_agree(library, name):
     design, slices = DESIGNS[name]
     co = coefficients(design, slices=slices)
