@@ -7,8 +7,10 @@
 #include <string.h>
 
 #define MAX_ITERATIONS 200
-#define LAYER_TOLERANCE 2e-15  /* relative step in a layer's strain: a few ulp */
-#define LOAD_TOLERANCE 1e-14   /* relative step in the channel's load: below the spec's 1e-13 */
+#define NEWTON_ITERATIONS 40   /* the one-level Newton's; beyond, the nested solve */
+#define NEWTON_TOLERANCE 1e-13 /* its relative steps in the load and the strains */
+#define LAYER_TOLERANCE 2e-15  /* nested solve: relative step in a layer's strain, a few ulp */
+#define LOAD_TOLERANCE 1e-14   /* nested solve: relative step in the channel's load */
 
 /* ------------------------------------------------------------------------------------------ */
 /* layout */
@@ -37,16 +39,36 @@ size_t bk_state_count(const bk_sizes *sizes)
     return bk_channel_state(sizes, BK_CHANNELS);
 }
 
-/* work: [h of the cache, B of the cache, e^{−λ_j h} (J), then per layer of the widest
- * channel: A_k, the current strain iterate, its slope] */
+/* one layer during a step: its law (the friction branches either side of the committed strain,
+ * [0] moving down, [1] moving up) and the series solve's iterate. Scratch, in the work buffer. */
+typedef struct {
+    double eps_c, sig_c, dir;  /* committed strain, friction stress, direction (−1, 0, +1) */
+    double z, at_c;            /* Σ m g_j e^{−λ_j h} z_j: the memory's stress; σ at ε_c */
+    double p, ic;              /* 2c/S and 1/c */
+    double er[2], sr[2], num[2], d0[2];  /* each branch's reversal point, σ_fmax − sσ_r, d_0 */
+    double eps, r, inv;        /* the iterate, its residual σ − pF, 1/σ' there */
+    int up;                    /* the iterate's branch */
+} layer_t;
+#define LAYER_DOUBLES ((sizeof(layer_t) + sizeof(double) - 1) / sizeof(double))
+
+/* work: [h of the cache, B of the cache, e^{−λ_j h} (J), m g_j e^{−λ_j h} (J), per layer of
+ * every channel 2c/S and 1/c, then a layer_t per layer of the widest channel] */
 enum { WORK_H, WORK_B, WORK_HEAD };
+
+static size_t all_layers(const bk_sizes *sizes)
+{
+    size_t n = 0;
+    for (int c = 0; c < BK_CHANNELS; c++) n += (size_t)sizes->layers[c];
+    return n;
+}
 
 size_t bk_work_count(const bk_sizes *sizes)
 {
     int widest = 0;
     for (int c = 0; c < BK_CHANNELS; c++)
         if (sizes->layers[c] > widest) widest = sizes->layers[c];
-    return WORK_HEAD + (size_t)sizes->exponentials + 3 * (size_t)widest;
+    return WORK_HEAD + 2 * (size_t)sizes->exponentials + 2 * all_layers(sizes)
+           + LAYER_DOUBLES * (size_t)widest;
 }
 
 void bk_work_reset(const bk_sizes *sizes, double *work)
@@ -163,58 +185,131 @@ int bk_check_parameters(const bk_sizes *sizes, const double *p, char *message, s
     return 0;
 }
 
-/* ------------------------------------------------------------------------------------------ */
 /* one layer's law over a step */
 
 typedef struct {
     double two_mu, beta, b;  /* 2µ, β, B = m Σ g_j e^{−λ_j h} + c_v / h */
-    double smax, ehalf;      /* friction: σ_fmax (0: none), ε½ */
 } law_t;
 
-typedef struct {
-    double a;                /* A_k: the fractional and viscous stress at ε = 0 */
-    double eps_c, sig_c;     /* the committed strain and its friction stress */
-    double eps_r, sig_r, s;  /* the friction branch: its reversal point and direction */
-} branch_t;
-
-/* the branch the layer moves on when its strain goes to the `side` of the committed strain:
- * on along its direction from its last reversal point, or reversing at the committed point */
-static void set_branch(branch_t *br, const double *layer, double side)
+/* the layer's stress σ(ε) and slope dσ/dε on branch `up`: elastic, memory (its stress at ε_c plus
+ * B(ε − ε_c)) and Berg friction σ_r + u(σ_fmax − sσ_r)/(d_0 + su), u = ε − ε_r */
+static double stress(const law_t *law, const layer_t *l, double eps, int up, double *slope)
 {
-    br->eps_c = layer[BK_LAYER_EPS];
-    br->sig_c = layer[BK_LAYER_SIG_F];
-    if (layer[BK_LAYER_DIR] == side) {
-        br->eps_r = layer[BK_LAYER_EPS_S];
-        br->sig_r = layer[BK_LAYER_SIG_S];
-    } else {
-        br->eps_r = br->eps_c;
-        br->sig_r = br->sig_c;
-    }
-    br->s = side;
+    double u = eps - l->er[up], d = l->d0[up] + (up ? u : -u), q = l->num[up] / d, e2 = eps * eps;
+    *slope = law->two_mu * (1.0 + 3.0 * law->beta * e2) + law->b + q * l->d0[up] / d;
+    return law->two_mu * eps * (1.0 + law->beta * e2) + l->z + law->b * (eps - l->eps_c)
+           + l->sr[up] + u * q;
 }
 
-static double friction(const law_t *law, const branch_t *br, double eps, double *slope)
+/* the layer's law for this step from its committed state: the memory's stress (four partial
+ * sums: no chain of J dependent additions) and both friction branches (without friction,
+ * σ_fmax = 0, the branches are flat at σ_r = 0) */
+static void prepare_layer(layer_t *l, const law_t *law, const double *layer, const double *gd,
+                          int J, double smax, double ehalf)
 {
-    if (!(law->smax > 0.0)) {
-        *slope = 0.0;
-        return 0.0;
+    const double *z = layer + BK_LAYER_HEAD;
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    int j = 0;
+    for (; j + 4 <= J; j += 4) {
+        s0 += gd[j] * z[j];
+        s1 += gd[j + 1] * z[j + 1];
+        s2 += gd[j + 2] * z[j + 2];
+        s3 += gd[j + 3] * z[j + 3];
     }
-    double u = eps - br->eps_r, s = br->s;
-    double num = law->smax - s * br->sig_r;
-    double d0 = law->ehalf * (1.0 - s * br->sig_r / law->smax);
-    double d = d0 + s * u;
-    *slope = num * d0 / (d * d);
-    return br->sig_r + u * num / d;
+    for (; j < J; j++) s0 += gd[j] * z[j];
+    l->z = (s0 + s1) + (s2 + s3);
+    l->eps_c = layer[BK_LAYER_EPS];
+    l->sig_c = layer[BK_LAYER_SIG_F];
+    l->dir = layer[BK_LAYER_DIR];
+    l->at_c = law->two_mu * l->eps_c * (1.0 + law->beta * l->eps_c * l->eps_c) + l->z + l->sig_c;
+    for (int up = 0; up < 2; up++) {
+        double s = up ? 1.0 : -1.0;
+        int on = l->dir == s;  /* on along its direction from its last reversal, or reversing */
+        l->er[up] = on ? layer[BK_LAYER_EPS_S] : l->eps_c;
+        l->sr[up] = on ? layer[BK_LAYER_SIG_S] : l->sig_c;
+        l->num[up] = smax > 0.0 ? smax - s * l->sr[up] : 0.0;
+        l->d0[up] = smax > 0.0 ? ehalf * (1.0 - s * l->sr[up] / smax) : 1.0;
+    }
 }
 
-/* the layer's stress σ(ε) and slope dσ/dε on its branch */
-static double stress(const law_t *law, const branch_t *br, double eps, double *slope)
+/* the layer's state after the step, ending at strain eps */
+static void commit_layer(const layer_t *l, const double *layer, double *out, double eps,
+                         const double *decay, int J)
 {
-    double fslope, e2 = eps * eps;
-    double sig = law->two_mu * eps * (1.0 + law->beta * e2) + br->a + law->b * eps
-                 + friction(law, br, eps, &fslope);
-    *slope = law->two_mu * (1.0 + 3.0 * law->beta * e2) + law->b + fslope;
-    return sig;
+    double step = eps - l->eps_c;
+    for (int j = 0; j < J; j++) out[BK_LAYER_HEAD + j] = decay[j] * (layer[BK_LAYER_HEAD + j] + step);
+    if (step == 0.0) {
+        if (out != layer) memcpy(out, layer, BK_LAYER_HEAD * sizeof(double));
+        return;
+    }
+    int up = step > 0.0;
+    double u = eps - l->er[up];
+    out[BK_LAYER_EPS_S] = l->er[up];
+    out[BK_LAYER_SIG_S] = l->sr[up];
+    out[BK_LAYER_DIR] = up ? 1.0 : -1.0;
+    out[BK_LAYER_SIG_F] = l->sr[up] + u * (l->num[up] / (l->d0[up] + (up ? u : -u)));
+    out[BK_LAYER_EPS] = eps;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* the series equations of a channel: σ_k(ε_k) = p_k F (p_k = 2c_k/S_k), Σ ε_k/c_k + C_b F = x */
+
+/* The one Newton over the N + 1 unknowns (ε_k, F), O(N) an iteration by the arrow-shaped
+ * Jacobian: δε_k = (p_k δF − r_k)/σ'_k and δF from the compatibility row. It starts at the
+ * committed strains on the branches the layers last moved along (the previous step's tangent);
+ * each iterate's branch is the side of ε_c it is on, and a step across ε_c (friction's kink)
+ * stops there. 0 when converged; 1 when it does not reduce its residual or runs out of
+ * iterations: the caller falls back to the nested solve. */
+static int series_newton(const law_t *law, layer_t *L, int n, double cb, double x, double scale,
+                         double *load, long *count)
+{
+    double F = *load, previous = INFINITY;
+    for (int k = 0; k < n; k++) L[k].eps = L[k].eps_c, L[k].up = L[k].dir >= 0.0;
+    for (int it = 0; it < NEWTON_ITERATIONS; it++) {
+        double g = cb * F - x, dg = cb, rg = 0.0, merit = 0.0;
+        for (int k = 0; k < n; k++) {
+            layer_t *l = &L[k];
+            if (l->eps != l->eps_c) {
+                l->up = l->eps > l->eps_c;
+            } else if (it > 0) {  /* at the kink: the side the load pushes it to */
+                double t = l->p * F - l->at_c;
+                if (t != 0.0) l->up = t > 0.0;
+            }
+            double slope, r = stress(law, l, l->eps, l->up, &slope) - l->p * F;
+            if (!isfinite(r) || !(slope > 0.0)) return 1;
+            l->r = r;
+            l->inv = 1.0 / slope;
+            double t = l->ic * l->inv;
+            g += l->eps * l->ic;
+            dg += l->p * t;
+            rg += r * t;
+            merit += fabs(r) * t;
+        }
+        if (count) *count += n;
+        merit += fabs(g);
+        if (it >= 4 && !(merit < previous)) return 1;
+        previous = merit;
+        double dF = (rg - g) / dg;
+        F += dF;
+        if (!isfinite(F)) return 1;
+        int done = fabs(dF) <= NEWTON_TOLERANCE * fmax(fabs(F), scale);
+        for (int k = 0; k < n; k++) {
+            layer_t *l = &L[k];
+            double de = (l->p * dF - l->r) * l->inv, eps = l->eps + de;
+            if (l->up ? eps < l->eps_c : eps > l->eps_c) {
+                eps = l->eps_c;
+                done = 0;
+            } else if (!(fabs(de) <= NEWTON_TOLERANCE * (fabs(eps) + fabs(l->eps_c)))) {
+                done = 0;
+            }
+            l->eps = eps;
+        }
+        if (done) {
+            *load = F;
+            return 0;
+        }
+    }
+    return 1;
 }
 
 /* a Newton step kept inside the bracket (lo, hi): bisection where it leaves it; away from the
@@ -228,33 +323,27 @@ static double bracketed(double x, double step, double lo, double hi)
     return 0.5 * (lo + hi);
 }
 
-/* the strain at which the layer carries the stress `target`; its slope there */
-static int solve_layer(const law_t *law, const double *layer, double a, double target,
-                       double guess, double *eps_out, double *slope_out, long *count)
+/* nested solve, inner: the strain at which the layer carries the stress `target` (safeguarded
+ * Newton from the layer's last iterate); l->eps, l->inv = 1/σ' there */
+static int layer_strain(const law_t *law, layer_t *l, double target, long *count)
 {
-    branch_t br;
-    br.a = a;
-    double eps_c = layer[BK_LAYER_EPS];
-    double at_rest = law->two_mu * eps_c * (1.0 + law->beta * eps_c * eps_c) + a + law->b * eps_c
-                     + layer[BK_LAYER_SIG_F];
-    double side = target > at_rest ? 1.0 : -1.0;
-    set_branch(&br, layer, side);
-    double slope, eps;
-    if (target == at_rest) {
-        stress(law, &br, eps_c, &slope);
-        *eps_out = eps_c;
-        *slope_out = slope;
+    double eps_c = l->eps_c, slope, eps;
+    int up = target > l->at_c;
+    if (target == l->at_c) {
+        l->eps = eps_c;
+        stress(law, l, eps_c, l->dir >= 0.0, &slope);
+        l->inv = 1.0 / slope;
         return 0;
     }
-    double lo = side > 0 ? eps_c : -INFINITY, hi = side > 0 ? INFINITY : eps_c;
-    if (guess > lo && guess < hi) {
-        eps = guess;
+    double lo = up ? eps_c : -INFINITY, hi = up ? INFINITY : eps_c;
+    if (l->eps > lo && l->eps < hi) {
+        eps = l->eps;
     } else {
-        stress(law, &br, eps_c, &slope);
-        eps = eps_c + (target - at_rest) / slope;
+        stress(law, l, eps_c, up, &slope);
+        eps = eps_c + (target - l->at_c) / slope;
     }
     for (int i = 0; i < MAX_ITERATIONS; i++) {
-        double r = stress(law, &br, eps, &slope) - target;
+        double r = stress(law, l, eps, up, &slope) - target;
         if (count) (*count)++;
         if (!isfinite(r) || !(slope > 0.0)) return 1;
         if (r == 0.0) break;
@@ -273,34 +362,46 @@ static int solve_layer(const law_t *law, const double *layer, double a, double t
         eps = next;
         if (i == MAX_ITERATIONS - 1) return 1;
     }
-    if (side > 0 ? eps < eps_c : eps > eps_c) eps = eps_c;  /* never across the reversal */
-    stress(law, &br, eps, &slope);
-    *eps_out = eps;
-    *slope_out = slope;
+    if (up ? eps < eps_c : eps > eps_c) eps = eps_c;  /* never across the reversal */
+    stress(law, l, eps, up, &slope);
+    l->eps = eps;
+    l->inv = 1.0 / slope;
     return 0;
 }
 
-/* the layer's state after the step, ending at strain eps */
-static void commit_layer(const law_t *law, const double *layer, double *out, double eps,
-                         const double *decay, int J)
+/* The nested solve (the fallback: slower, robust): g(F) = Σ ε_k(F)/c_k + C_b F − x increases
+ * strictly; Newton on F safeguarded by bisection, each ε_k(F) by layer_strain. 0 when converged;
+ * 1 with a sentence in text. */
+static int series_nested(const law_t *law, layer_t *L, int n, double cb, double x, double scale,
+                         double *load, long *count, char *text, size_t length)
 {
-    double eps_c = layer[BK_LAYER_EPS];
-    for (int j = 0; j < J; j++)
-        out[BK_LAYER_HEAD + j] = decay[j] * (layer[BK_LAYER_HEAD + j] + eps - eps_c);
-    if (eps == eps_c) {
-        if (out != layer) memcpy(out, layer, BK_LAYER_HEAD * sizeof(double));
-        return;
+    double lo = -INFINITY, hi = INFINITY, F = *load;
+    for (int k = 0; k < n; k++) L[k].eps = L[k].eps_c;
+    for (int i = 0; i < MAX_ITERATIONS; i++) {
+        double g = cb * F - x, dg = cb;
+        for (int k = 0; k < n; k++) {
+            if (layer_strain(law, &L[k], L[k].p * F, count)) {
+                snprintf(text, length, "layer %d: the layer's strain did not converge at load %g",
+                         k + 1, F);
+                return 1;
+            }
+            g += L[k].eps * L[k].ic;
+            dg += L[k].p * L[k].ic * L[k].inv;
+        }
+        if (g == 0.0) break;
+        if (g < 0.0) lo = F; else hi = F;
+        double step = -g / dg, guess = bracketed(F, step, lo, hi);
+        double tol = LOAD_TOLERANCE * fmax(fabs(F), scale);
+        if (fabs(step) <= tol || hi - lo <= tol) break;
+        if (i == MAX_ITERATIONS - 1 || !isfinite(guess)) {
+            snprintf(text, length, "the series equations did not converge in %d iterations",
+                     MAX_ITERATIONS);
+            return 1;
+        }
+        F = guess;
     }
-    double side = eps > eps_c ? 1.0 : -1.0, slope;
-    branch_t br;
-    br.a = 0.0;
-    set_branch(&br, layer, side);
-    double sig_f = friction(law, &br, eps, &slope);
-    out[BK_LAYER_EPS_S] = br.eps_r;
-    out[BK_LAYER_SIG_S] = br.sig_r;
-    out[BK_LAYER_DIR] = side;
-    out[BK_LAYER_SIG_F] = sig_f;
-    out[BK_LAYER_EPS] = eps;
+    *load = F;
+    return 0;
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -310,7 +411,7 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
                const double x[BK_CHANNELS], double h, double f[BK_CHANNELS], double *work,
                long *evaluations, char *message, size_t length)
 {
-    char text[BK_MESSAGE];
+    char text[BK_MESSAGE], why[BK_MESSAGE / 2];
     int J = sizes->exponentials;
     size_t layer_size = BK_LAYER_HEAD + (size_t)J;
     if (!isfinite(h) || !(h > 0.0)) {
@@ -324,81 +425,58 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
             return fail(message, length, text);
         }
     }
-    double *decay = work + WORK_HEAD;
-    if (work[WORK_H] != h) {  /* e^{−λ_j h} and B, once per step size */
+    double *decay = work + WORK_HEAD, *gd = decay + J, *pc = gd + J;
+    layer_t *L = (layer_t *)(pc + 2 * all_layers(sizes));
+    if (work[WORK_H] != h) {  /* once per step size (and after bk_work_reset) */
         double b = 0.0;
         for (int j = 0; j < J; j++) {
             decay[j] = exp(-p[BK_SCALARS + j] * h);
-            b += p[BK_SCALARS + J + j] * decay[j];
+            gd[j] = p[BK_M] * p[BK_SCALARS + J + j] * decay[j];
+            b += gd[j];
         }
-        work[WORK_B] = p[BK_M] * b + p[BK_VISCOSITY] / h;
+        work[WORK_B] = b + p[BK_VISCOSITY] / h;
         work[WORK_H] = h;
+        double *at = pc;
+        for (int c = 0; c < BK_CHANNELS; c++) {
+            int n = sizes->layers[c];
+            const double *S = p + bk_channel_parameters(sizes, c), *cf = S + n;
+            for (int k = 0; k < n; k++, at += 2) at[0] = 2.0 * cf[k] / S[k], at[1] = 1.0 / cf[k];
+        }
     }
-    law_t law = {2.0 * p[BK_MU], p[BK_BETA], work[WORK_B], p[BK_SIGMA_F_MAX], p[BK_EPS_HALF]};
-    const double *weight = p + BK_SCALARS + J;
+    law_t law = {2.0 * p[BK_MU], p[BK_BETA], work[WORK_B]};
+    double smax = p[BK_SIGMA_F_MAX], ehalf = p[BK_EPS_HALF];
     for (int c = 0; c < BK_CHANNELS; c++) {
         int n = sizes->layers[c];
-        const double *S = p + bk_channel_parameters(sizes, c), *cf = S + n;
-        double compliance = cf[n];
+        double compliance = p[bk_channel_parameters(sizes, c) + 2 * (size_t)n];
         const double *ch = state + bk_channel_state(sizes, c);
         double *out = next + bk_channel_state(sizes, c);
-        double *A = decay + J, *eps = A + n, *slope = eps + n;
-        double load;
+        double load = ch[BK_CHANNEL_F];
         for (int k = 0; k < n; k++) {
-            const double *layer = ch + BK_CHANNEL_HEAD + k * layer_size;
-            double e_n = layer[BK_LAYER_EPS], frac = 0.0;
-            for (int j = 0; j < J; j++) frac += weight[j] * decay[j] * (layer[BK_LAYER_HEAD + j] - e_n);
-            A[k] = p[BK_M] * frac - p[BK_VISCOSITY] * e_n / h;
-            eps[k] = e_n;
+            prepare_layer(&L[k], &law, ch + BK_CHANNEL_HEAD + k * layer_size, gd, J, smax, ehalf);
+            L[k].p = pc[0];
+            L[k].ic = pc[1];
+            pc += 2;
         }
         if (n == 1 && compliance == 0.0) {
             /* one layer, no bulk spring: its strain is the drive's, the load follows */
-            const double *layer = ch + BK_CHANNEL_HEAD;
-            branch_t br;
-            br.a = A[0];
-            eps[0] = cf[0] * x[c];
-            set_branch(&br, layer, eps[0] > layer[BK_LAYER_EPS] ? 1.0 : -1.0);
-            if (eps[0] == layer[BK_LAYER_EPS]) br.eps_r = br.eps_c, br.sig_r = br.sig_c;
-            load = stress(&law, &br, eps[0], &slope[0]) * S[0] / (2.0 * cf[0]);
+            double slope, eps = x[c] / L[0].ic;
+            L[0].eps = eps;
+            load = stress(&law, &L[0], eps, eps > L[0].eps_c, &slope) / L[0].p;
             if (evaluations) (*evaluations)++;
         } else {
-            /* the load F with Σ ε_k(F)/c_k + C_b F = x, each ε_k from σ_k(ε_k) = (2c_k/S_k) F:
-             * g(F) increases strictly; Newton on F, safeguarded by bisection */
             double soft = compliance;
-            for (int k = 0; k < n; k++) soft += 2.0 / (S[k] * (law.two_mu + law.b));
-            double scale = fmax(fabs(ch[BK_CHANNEL_F]),
-                                (fabs(x[c]) + fabs(ch[BK_CHANNEL_X])) / soft);
-            double lo = -INFINITY, hi = INFINITY;
-            load = ch[BK_CHANNEL_F];
-            int done = 0;
-            for (int i = 0; i < MAX_ITERATIONS && !done; i++) {
-                double g = compliance * load - x[c], dg = compliance;
-                for (int k = 0; k < n; k++) {
-                    double pk = 2.0 * cf[k] / S[k];
-                    const double *layer = ch + BK_CHANNEL_HEAD + k * layer_size;
-                    if (solve_layer(&law, layer, A[k], pk * load, eps[k], &eps[k], &slope[k],
-                                    evaluations)) {
-                        snprintf(text, sizeof text,
-                                 "channel %s, layer %d: the layer's strain did not converge at "
-                                 "load %g", CHANNEL_NAMES[c], k + 1, load);
-                        return fail(message, length, text);
-                    }
-                    g += eps[k] / cf[k];
-                    dg += pk / (cf[k] * slope[k]);
-                }
-                if (g == 0.0) break;
-                if (g < 0.0) lo = load; else hi = load;
-                double step = -g / dg, guess = bracketed(load, step, lo, hi);
-                double tol = LOAD_TOLERANCE * fmax(fabs(load), scale);
-                done = fabs(step) <= tol || hi - lo <= tol;
-                if (!done) {
-                    if (i == MAX_ITERATIONS - 1 || !isfinite(guess)) {
-                        snprintf(text, sizeof text,
-                                 "channel %s: the series equations did not converge in %d "
-                                 "iterations (drive %g)", CHANNEL_NAMES[c], MAX_ITERATIONS, x[c]);
-                        return fail(message, length, text);
-                    }
-                    load = guess;
+            for (int k = 0; k < n; k++) soft += L[k].ic * L[k].p / (law.two_mu + law.b);
+            double scale = fmax(fabs(load), (fabs(x[c]) + fabs(ch[BK_CHANNEL_X])) / soft);
+#ifndef BK_SERIES_NESTED_ONLY
+            if (series_newton(&law, L, n, compliance, x[c], scale, &load, evaluations))
+#endif
+            {
+                load = ch[BK_CHANNEL_F];
+                if (series_nested(&law, L, n, compliance, x[c], scale, &load, evaluations, why,
+                                  sizeof why)) {
+                    snprintf(text, sizeof text, "channel %s: %s (drive %g)", CHANNEL_NAMES[c],
+                             why, x[c]);
+                    return fail(message, length, text);
                 }
             }
         }
@@ -409,7 +487,7 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
         }
         for (int k = 0; k < n; k++) {
             const double *layer = ch + BK_CHANNEL_HEAD + k * layer_size;
-            commit_layer(&law, layer, out + BK_CHANNEL_HEAD + k * layer_size, eps[k], decay, J);
+            commit_layer(&L[k], layer, out + BK_CHANNEL_HEAD + k * layer_size, L[k].eps, decay, J);
         }
         out[BK_CHANNEL_X] = x[c];
         out[BK_CHANNEL_F] = load;
