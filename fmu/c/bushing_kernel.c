@@ -9,6 +9,7 @@
 #define MAX_ITERATIONS 200
 #define NEWTON_ITERATIONS 40   /* the one-level Newton's; beyond, the nested solve */
 #define NEWTON_TOLERANCE 1e-13 /* its relative steps in the load and the strains */
+#define GUESS_RATIO 2.0        /* the last step's changes guess the next within this ratio */
 #define LAYER_TOLERANCE 2e-15  /* nested solve: relative step in a layer's strain, a few ulp */
 #define LOAD_TOLERANCE 1e-14   /* nested solve: relative step in the channel's load */
 
@@ -193,10 +194,11 @@ typedef struct {
 
 /* the layer's stress σ(ε) and slope dσ/dε on branch `up`: elastic, memory (its stress at ε_c plus
  * B(ε − ε_c)) and Berg friction σ_r + u(σ_fmax − sσ_r)/(d_0 + su), u = ε − ε_r */
-static double stress(const law_t *law, const layer_t *l, double eps, int up, double *slope)
+static inline double stress(const law_t *law, const layer_t *l, double eps, int up, double *slope)
 {
-    double u = eps - l->er[up], d = l->d0[up] + (up ? u : -u), q = l->num[up] / d, e2 = eps * eps;
-    *slope = law->two_mu * (1.0 + 3.0 * law->beta * e2) + law->b + q * l->d0[up] / d;
+    double u = eps - l->er[up], w = 1.0 / (l->d0[up] + (up ? u : -u)), q = l->num[up] * w;
+    double e2 = eps * eps;
+    *slope = law->two_mu * (1.0 + 3.0 * law->beta * e2) + law->b + q * l->d0[up] * w;
     return law->two_mu * eps * (1.0 + law->beta * e2) + l->z + law->b * (eps - l->eps_c)
            + l->sr[up] + u * q;
 }
@@ -205,7 +207,7 @@ static double stress(const law_t *law, const layer_t *l, double eps, int up, dou
  * sums: no chain of J dependent additions) and both friction branches (without friction,
  * σ_fmax = 0, the branches are flat at σ_r = 0) */
 static void prepare_layer(layer_t *l, const law_t *law, const double *layer, const double *gd,
-                          int J, double smax, double ehalf)
+                          int J, double smax, double ehalf_smax, double ehalf)
 {
     const double *z = layer + BK_LAYER_HEAD;
     double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
@@ -228,7 +230,7 @@ static void prepare_layer(layer_t *l, const law_t *law, const double *layer, con
         l->er[up] = on ? layer[BK_LAYER_EPS_S] : l->eps_c;
         l->sr[up] = on ? layer[BK_LAYER_SIG_S] : l->sig_c;
         l->num[up] = smax > 0.0 ? smax - s * l->sr[up] : 0.0;
-        l->d0[up] = smax > 0.0 ? ehalf * (1.0 - s * l->sr[up] / smax) : 1.0;
+        l->d0[up] = smax > 0.0 ? ehalf - s * l->sr[up] * ehalf_smax : 1.0;
     }
 }
 
@@ -238,8 +240,9 @@ static void commit_layer(const layer_t *l, const double *layer, double *out, dou
 {
     double step = eps - l->eps_c;
     for (int j = 0; j < J; j++) out[BK_LAYER_HEAD + j] = decay[j] * (layer[BK_LAYER_HEAD + j] + step);
+    out[BK_LAYER_STEP] = step;
     if (step == 0.0) {
-        if (out != layer) memcpy(out, layer, BK_LAYER_HEAD * sizeof(double));
+        if (out != layer) memcpy(out, layer, BK_LAYER_STEP * sizeof(double));
         return;
     }
     int up = step > 0.0;
@@ -254,17 +257,28 @@ static void commit_layer(const layer_t *l, const double *layer, double *out, dou
 /* ------------------------------------------------------------------------------------------ */
 /* the series equations of a channel: σ_k(ε_k) = p_k F (p_k = 2c_k/S_k), Σ ε_k/c_k + C_b F = x */
 
+static inline double larger(double a, double b) { return a > b ? a : b; }
+
 /* The one Newton over the N + 1 unknowns (ε_k, F), O(N) an iteration by the arrow-shaped
- * Jacobian: δε_k = (p_k δF − r_k)/σ'_k and δF from the compatibility row. It starts at the
- * committed strains on the branches the layers last moved along (the previous step's tangent);
- * each iterate's branch is the side of ε_c it is on, and a step across ε_c (friction's kink)
- * stops there. 0 when converged; 1 when it does not reduce its residual or runs out of
- * iterations: the caller falls back to the nested solve. */
-static int series_newton(const law_t *law, layer_t *L, int n, double cb, double x, double scale,
-                         double *load, long *count)
+ * Jacobian: δε_k = (p_k δF − r_k)/σ'_k and δF from the compatibility row (the equations are
+ * linear in F: the first iterate needs strains only). It starts from the strains the last step's
+ * changes extrapolate to, by `ratio` = this step's change of the drive over the last one (0: at
+ * the committed strains, on the branches the layers last moved along: the last step's tangent).
+ * Each iterate's branch is the side of ε_c it is on; a step across ε_c (friction's kink) stops
+ * there. It ends when its relative step is below NEWTON_TOLERANCE, or when the step before
+ * the last was already small and the last one shows quadratic convergence (s_i (s_i/s_{i−1})²,
+ * the next step's size, below NEWTON_TOLERANCE / 100). 0 when converged; 1 when it does not
+ * reduce its residual or runs out of iterations: the caller falls back to the nested solve. */
+static int series_newton(const law_t *law, layer_t *L, const double *layer, size_t layer_size,
+                         int n, double cb, double x, double ratio, double scale, double *load,
+                         long *count)
 {
-    double F = *load, previous = INFINITY;
-    for (int k = 0; k < n; k++) L[k].eps = L[k].eps_c, L[k].up = L[k].dir >= 0.0;
+    double F = *load, previous = INFINITY, last = INFINITY;
+    for (int k = 0; k < n; k++) {
+        layer_t *l = &L[k];
+        l->eps = l->eps_c + ratio * layer[k * layer_size + BK_LAYER_STEP];
+        l->up = l->eps != l->eps_c ? l->eps > l->eps_c : l->dir >= 0.0;
+    }
     for (int it = 0; it < NEWTON_ITERATIONS; it++) {
         double g = cb * F - x, dg = cb, rg = 0.0, merit = 0.0;
         for (int k = 0; k < n; k++) {
@@ -292,22 +306,26 @@ static int series_newton(const law_t *law, layer_t *L, int n, double cb, double 
         double dF = (rg - g) / dg;
         F += dF;
         if (!isfinite(F)) return 1;
-        int done = fabs(dF) <= NEWTON_TOLERANCE * fmax(fabs(F), scale);
+        double size = it ? fabs(dF) / larger(fabs(F), scale) : 0.0;  /* F₀: no guess */
+        int kinked = 0;
         for (int k = 0; k < n; k++) {
             layer_t *l = &L[k];
             double de = (l->p * dF - l->r) * l->inv, eps = l->eps + de;
             if (l->up ? eps < l->eps_c : eps > l->eps_c) {
                 eps = l->eps_c;
-                done = 0;
-            } else if (!(fabs(de) <= NEWTON_TOLERANCE * (fabs(eps) + fabs(l->eps_c)))) {
-                done = 0;
+                kinked = 1;
             }
+            double e = fabs(de), room = fabs(eps) + fabs(l->eps_c);
+            if (e > size * room) size = room > 0.0 ? e / room : INFINITY;
             l->eps = eps;
         }
-        if (done) {
+        if (!kinked && (size <= NEWTON_TOLERANCE
+                        || (last < 1e-3 && size * (size / last) * (size / last)
+                                               <= 0.01 * NEWTON_TOLERANCE))) {
             *load = F;
             return 0;
         }
+        last = kinked ? INFINITY : size;
     }
     return 1;
 }
@@ -349,7 +367,7 @@ static int layer_strain(const law_t *law, layer_t *l, double target, long *count
         if (r == 0.0) break;
         if (r < 0.0) lo = eps; else hi = eps;
         double step = -r / slope;
-        double tol = LAYER_TOLERANCE * fmax(fabs(eps), fabs(eps - eps_c));
+        double tol = LAYER_TOLERANCE * larger(fabs(eps), fabs(eps - eps_c));
         if (fabs(step) <= tol) {
             eps += step;
             break;
@@ -391,7 +409,7 @@ static int series_nested(const law_t *law, layer_t *L, int n, double cb, double 
         if (g == 0.0) break;
         if (g < 0.0) lo = F; else hi = F;
         double step = -g / dg, guess = bracketed(F, step, lo, hi);
-        double tol = LOAD_TOLERANCE * fmax(fabs(F), scale);
+        double tol = LOAD_TOLERANCE * larger(fabs(F), scale);
         if (fabs(step) <= tol || hi - lo <= tol) break;
         if (i == MAX_ITERATIONS - 1 || !isfinite(guess)) {
             snprintf(text, length, "the series equations did not converge in %d iterations",
@@ -445,6 +463,7 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
     }
     law_t law = {2.0 * p[BK_MU], p[BK_BETA], work[WORK_B]};
     double smax = p[BK_SIGMA_F_MAX], ehalf = p[BK_EPS_HALF];
+    double ehalf_smax = smax > 0.0 ? ehalf / smax : 0.0;
     for (int c = 0; c < BK_CHANNELS; c++) {
         int n = sizes->layers[c];
         double compliance = p[bk_channel_parameters(sizes, c) + 2 * (size_t)n];
@@ -452,7 +471,8 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
         double *out = next + bk_channel_state(sizes, c);
         double load = ch[BK_CHANNEL_F];
         for (int k = 0; k < n; k++) {
-            prepare_layer(&L[k], &law, ch + BK_CHANNEL_HEAD + k * layer_size, gd, J, smax, ehalf);
+            prepare_layer(&L[k], &law, ch + BK_CHANNEL_HEAD + k * layer_size, gd, J, smax,
+                          ehalf_smax, ehalf);
             L[k].p = pc[0];
             L[k].ic = pc[1];
             pc += 2;
@@ -466,9 +486,12 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
         } else {
             double soft = compliance;
             for (int k = 0; k < n; k++) soft += L[k].ic * L[k].p / (law.two_mu + law.b);
-            double scale = fmax(fabs(load), (fabs(x[c]) + fabs(ch[BK_CHANNEL_X])) / soft);
+            double scale = larger(fabs(load), (fabs(x[c]) + fabs(ch[BK_CHANNEL_X])) / soft);
+            double change = x[c] - ch[BK_CHANNEL_X], ratio = change / ch[BK_CHANNEL_STEP];
+            if (!(fabs(ratio) <= GUESS_RATIO)) ratio = 0.0;  /* also 0/0: held, or from rest */
 #ifndef BK_SERIES_NESTED_ONLY
-            if (series_newton(&law, L, n, compliance, x[c], scale, &load, evaluations))
+            if (series_newton(&law, L, ch + BK_CHANNEL_HEAD, layer_size, n, compliance, x[c],
+                              ratio, scale, &load, evaluations))
 #endif
             {
                 load = ch[BK_CHANNEL_F];
@@ -489,6 +512,7 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
             const double *layer = ch + BK_CHANNEL_HEAD + k * layer_size;
             commit_layer(&L[k], layer, out + BK_CHANNEL_HEAD + k * layer_size, L[k].eps, decay, J);
         }
+        out[BK_CHANNEL_STEP] = x[c] - ch[BK_CHANNEL_X];
         out[BK_CHANNEL_X] = x[c];
         out[BK_CHANNEL_F] = load;
         f[c] = load;
