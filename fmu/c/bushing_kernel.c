@@ -45,15 +45,15 @@ size_t bk_state_count(const bk_sizes *sizes)
 typedef struct {
     double eps_c, sig_c, dir;  /* committed strain, friction stress, direction (−1, 0, +1) */
     double z, at_c;            /* Σ m g_j e^{−λ_j h} z_j: the memory's stress; σ at ε_c */
-    double p, ic;              /* 2c/S and 1/c */
+    double p, ip, c, ic;       /* p = 2c/S, 1/p, c and 1/c */
     double er[2], sr[2], num[2], d0[2];  /* each branch's reversal point, σ_fmax − sσ_r, d_0 */
-    double eps, r, inv;        /* the iterate, its residual σ − pF, 1/σ' there */
+    double eps, r, inv;        /* the iterate, its correction (σ − pF)/σ', 1/σ' there */
     int up;                    /* the iterate's branch */
 } layer_t;
 #define LAYER_DOUBLES ((sizeof(layer_t) + sizeof(double) - 1) / sizeof(double))
 
 /* work: [h of the cache, B of the cache, e^{−λ_j h} (J), m g_j e^{−λ_j h} (J), per layer of
- * every channel 2c/S and 1/c, then a layer_t per layer of the widest channel] */
+ * every channel 2c/S, S/(2c), c and 1/c, then a layer_t per layer of the widest channel] */
 enum { WORK_H, WORK_B, WORK_HEAD };
 
 static size_t all_layers(const bk_sizes *sizes)
@@ -68,7 +68,7 @@ size_t bk_work_count(const bk_sizes *sizes)
     int widest = 0;
     for (int c = 0; c < BK_CHANNELS; c++)
         if (sizes->layers[c] > widest) widest = sizes->layers[c];
-    return WORK_HEAD + 2 * (size_t)sizes->exponentials + 2 * all_layers(sizes)
+    return WORK_HEAD + 2 * (size_t)sizes->exponentials + 4 * all_layers(sizes)
            + LAYER_DOUBLES * (size_t)widest;
 }
 
@@ -194,13 +194,29 @@ typedef struct {
 
 /* the layer's stress σ(ε) and slope dσ/dε on branch `up`: elastic, memory (its stress at ε_c plus
  * B(ε − ε_c)) and Berg friction σ_r + u(σ_fmax − sσ_r)/(d_0 + su), u = ε − ε_r */
-static inline double stress(const law_t *law, const layer_t *l, double eps, int up, double *slope)
+static inline double stress(const law_t *law, const layer_t *l, double eps, int up, double *slope,
+                            double *friction)
 {
     double u = eps - l->er[up], w = 1.0 / (l->d0[up] + (up ? u : -u)), q = l->num[up] * w;
     double e2 = eps * eps;
     *slope = law->two_mu * (1.0 + 3.0 * law->beta * e2) + law->b + q * l->d0[up] * w;
-    return law->two_mu * eps * (1.0 + law->beta * e2) + l->z + law->b * (eps - l->eps_c)
-           + l->sr[up] + u * q;
+    *friction = l->sr[up] + u * q;
+    return law->two_mu * eps * (1.0 + law->beta * e2) + l->z + law->b * (eps - l->eps_c) + *friction;
+}
+
+/* Newton's correction of the layer's strain for the stress target, in one division: with
+ * d = d_0 + su, (σ − target)/σ' = N d/D and 1/σ' = d²/D, N = (σ − target) d and D = σ' d²;
+ * *inv = 1/σ'. Returns (σ − target)/σ'. */
+static inline double correction(const law_t *law, const layer_t *l, double eps, int up,
+                                double target, double *inv)
+{
+    double u = eps - l->er[up], d = l->d0[up] + (up ? u : -u), e2 = eps * eps;
+    double rest = law->two_mu * eps * (1.0 + law->beta * e2) + l->z + law->b * (eps - l->eps_c)
+                  + l->sr[up] - target;
+    double slope = law->two_mu * (1.0 + 3.0 * law->beta * e2) + law->b;
+    double w = d / (slope * d * d + l->num[up] * l->d0[up]);
+    *inv = d * w;
+    return (rest * d + u * l->num[up]) * w;
 }
 
 /* the layer's law for this step from its committed state: the memory's stress (four partial
@@ -236,7 +252,7 @@ static void prepare_layer(layer_t *l, const law_t *law, const double *layer, con
 
 /* the layer's state after the step, ending at strain eps */
 static void commit_layer(const layer_t *l, const double *layer, double *out, double eps,
-                         const double *decay, int J)
+                         const double *decay, int J, const double *friction)
 {
     double step = eps - l->eps_c;
     for (int j = 0; j < J; j++) out[BK_LAYER_HEAD + j] = decay[j] * (layer[BK_LAYER_HEAD + j] + step);
@@ -250,7 +266,7 @@ static void commit_layer(const layer_t *l, const double *layer, double *out, dou
     out[BK_LAYER_EPS_S] = l->er[up];
     out[BK_LAYER_SIG_S] = l->sr[up];
     out[BK_LAYER_DIR] = up ? 1.0 : -1.0;
-    out[BK_LAYER_SIG_F] = l->sr[up] + u * (l->num[up] / (l->d0[up] + (up ? u : -u)));
+    out[BK_LAYER_SIG_F] = friction ? *friction : l->sr[up] + u * (l->num[up] / (l->d0[up] + (up ? u : -u)));
     out[BK_LAYER_EPS] = eps;
 }
 
@@ -289,15 +305,13 @@ static int series_newton(const law_t *law, layer_t *L, const double *layer, size
                 double t = l->p * F - l->at_c;
                 if (t != 0.0) l->up = t > 0.0;
             }
-            double slope, r = stress(law, l, l->eps, l->up, &slope) - l->p * F;
-            if (!isfinite(r) || !(slope > 0.0)) return 1;
-            l->r = r;
-            l->inv = 1.0 / slope;
-            double t = l->ic * l->inv;
+            double ri = correction(law, l, l->eps, l->up, l->p * F, &l->inv);
+            if (!isfinite(ri) || !(l->inv > 0.0)) return 1;
+            l->r = ri;
             g += l->eps * l->ic;
-            dg += l->p * t;
-            rg += r * t;
-            merit += fabs(r) * t;
+            dg += l->p * l->ic * l->inv;
+            rg += ri * l->ic;
+            merit += fabs(ri) * l->ic;
         }
         if (count) *count += n;
         merit += fabs(g);
@@ -310,7 +324,7 @@ static int series_newton(const law_t *law, layer_t *L, const double *layer, size
         int kinked = 0;
         for (int k = 0; k < n; k++) {
             layer_t *l = &L[k];
-            double de = (l->p * dF - l->r) * l->inv, eps = l->eps + de;
+            double de = l->p * dF * l->inv - l->r, eps = l->eps + de;
             if (l->up ? eps < l->eps_c : eps > l->eps_c) {
                 eps = l->eps_c;
                 kinked = 1;
@@ -345,11 +359,11 @@ static double bracketed(double x, double step, double lo, double hi)
  * Newton from the layer's last iterate); l->eps, l->inv = 1/σ' there */
 static int layer_strain(const law_t *law, layer_t *l, double target, long *count)
 {
-    double eps_c = l->eps_c, slope, eps;
+    double eps_c = l->eps_c, slope, eps, friction;
     int up = target > l->at_c;
     if (target == l->at_c) {
         l->eps = eps_c;
-        stress(law, l, eps_c, l->dir >= 0.0, &slope);
+        stress(law, l, eps_c, l->dir >= 0.0, &slope, &friction);
         l->inv = 1.0 / slope;
         return 0;
     }
@@ -357,11 +371,11 @@ static int layer_strain(const law_t *law, layer_t *l, double target, long *count
     if (l->eps > lo && l->eps < hi) {
         eps = l->eps;
     } else {
-        stress(law, l, eps_c, up, &slope);
+        stress(law, l, eps_c, up, &slope, &friction);
         eps = eps_c + (target - l->at_c) / slope;
     }
     for (int i = 0; i < MAX_ITERATIONS; i++) {
-        double r = stress(law, l, eps, up, &slope) - target;
+        double r = stress(law, l, eps, up, &slope, &friction) - target;
         if (count) (*count)++;
         if (!isfinite(r) || !(slope > 0.0)) return 1;
         if (r == 0.0) break;
@@ -381,7 +395,7 @@ static int layer_strain(const law_t *law, layer_t *l, double target, long *count
         if (i == MAX_ITERATIONS - 1) return 1;
     }
     if (up ? eps < eps_c : eps > eps_c) eps = eps_c;  /* never across the reversal */
-    stress(law, l, eps, up, &slope);
+    stress(law, l, eps, up, &slope, &friction);
     l->eps = eps;
     l->inv = 1.0 / slope;
     return 0;
@@ -444,7 +458,7 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
         }
     }
     double *decay = work + WORK_HEAD, *gd = decay + J, *pc = gd + J;
-    layer_t *L = (layer_t *)(pc + 2 * all_layers(sizes));
+    layer_t *L = (layer_t *)(pc + 4 * all_layers(sizes));
     if (work[WORK_H] != h) {  /* once per step size (and after bk_work_reset) */
         double b = 0.0;
         for (int j = 0; j < J; j++) {
@@ -458,7 +472,12 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
         for (int c = 0; c < BK_CHANNELS; c++) {
             int n = sizes->layers[c];
             const double *S = p + bk_channel_parameters(sizes, c), *cf = S + n;
-            for (int k = 0; k < n; k++, at += 2) at[0] = 2.0 * cf[k] / S[k], at[1] = 1.0 / cf[k];
+            for (int k = 0; k < n; k++, at += 4) {
+                at[0] = 2.0 * cf[k] / S[k];
+                at[1] = S[k] / (2.0 * cf[k]);
+                at[2] = cf[k];
+                at[3] = 1.0 / cf[k];
+            }
         }
     }
     law_t law = {2.0 * p[BK_MU], p[BK_BETA], work[WORK_B]};
@@ -469,19 +488,22 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
         double compliance = p[bk_channel_parameters(sizes, c) + 2 * (size_t)n];
         const double *ch = state + bk_channel_state(sizes, c);
         double *out = next + bk_channel_state(sizes, c);
-        double load = ch[BK_CHANNEL_F];
+        double load = ch[BK_CHANNEL_F], friction, *known = NULL;
         for (int k = 0; k < n; k++) {
             prepare_layer(&L[k], &law, ch + BK_CHANNEL_HEAD + k * layer_size, gd, J, smax,
                           ehalf_smax, ehalf);
             L[k].p = pc[0];
-            L[k].ic = pc[1];
-            pc += 2;
+            L[k].ip = pc[1];
+            L[k].c = pc[2];
+            L[k].ic = pc[3];
+            pc += 4;
         }
         if (n == 1 && compliance == 0.0) {
             /* one layer, no bulk spring: its strain is the drive's, the load follows */
-            double slope, eps = x[c] / L[0].ic;
+            double slope, eps = x[c] * L[0].c;
             L[0].eps = eps;
-            load = stress(&law, &L[0], eps, eps > L[0].eps_c, &slope) / L[0].p;
+            load = stress(&law, &L[0], eps, eps > L[0].eps_c, &slope, &friction) * L[0].ip;
+            known = &friction;
             if (evaluations) (*evaluations)++;
         } else {
             double soft = compliance;
@@ -510,7 +532,8 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
         }
         for (int k = 0; k < n; k++) {
             const double *layer = ch + BK_CHANNEL_HEAD + k * layer_size;
-            commit_layer(&L[k], layer, out + BK_CHANNEL_HEAD + k * layer_size, L[k].eps, decay, J);
+            commit_layer(&L[k], layer, out + BK_CHANNEL_HEAD + k * layer_size, L[k].eps, decay, J,
+                         known);
         }
         out[BK_CHANNEL_STEP] = x[c] - ch[BK_CHANNEL_X];
         out[BK_CHANNEL_X] = x[c];
