@@ -48,12 +48,14 @@ typedef struct {
     double p, ip, c, ic;       /* p = 2c/S, 1/p, c and 1/c */
     double er[2], sr[2], num[2], d0[2];  /* each branch's reversal point, σ_fmax − sσ_r, d_0 */
     double eps, r, inv;        /* the iterate, its correction (σ − pF)/σ', 1/σ' there */
+    double fr;                 /* the friction stress at the final strain (one-layer path) */
     int up;                    /* the iterate's branch */
 } layer_t;
 #define LAYER_DOUBLES ((sizeof(layer_t) + sizeof(double) - 1) / sizeof(double))
 
-/* work: [h of the cache, B of the cache, e^{−λ_j h} (J), m g_j e^{−λ_j h} (J), per layer of
- * every channel 2c/S, S/(2c), c and 1/c, then a layer_t per layer of the widest channel] */
+/* work: [h of the cache, B of the cache, e^{−λ_j h} (J), m g_j e^{−λ_j h} (J), each channel's
+ * elastic stiffness, per layer of every channel 2c/S, S/(2c), c and 1/c, then a layer_t per
+ * layer of the widest channel] */
 enum { WORK_H, WORK_B, WORK_HEAD };
 
 static size_t all_layers(const bk_sizes *sizes)
@@ -68,7 +70,7 @@ size_t bk_work_count(const bk_sizes *sizes)
     int widest = 0;
     for (int c = 0; c < BK_CHANNELS; c++)
         if (sizes->layers[c] > widest) widest = sizes->layers[c];
-    return WORK_HEAD + 2 * (size_t)sizes->exponentials + 4 * all_layers(sizes)
+    return WORK_HEAD + 2 * (size_t)sizes->exponentials + BK_CHANNELS + 4 * all_layers(sizes)
            + LAYER_DOUBLES * (size_t)widest;
 }
 
@@ -205,17 +207,16 @@ static inline double stress(const law_t *law, const layer_t *l, double eps, int 
 }
 
 /* Newton's correction of the layer's strain for the stress target, in one division: with
- * d = d_0 + su, (σ − target)/σ' = N d/D and 1/σ' = d²/D, N = (σ − target) d and D = σ' d²;
- * *inv = 1/σ'. Returns (σ − target)/σ'. */
-static inline double correction(const law_t *law, const layer_t *l, double eps, int up,
-                                double target, double *inv)
+ * d = d_0 + su, (σ − target)/σ' = N d/D and 1/σ' = d²/D, N = (σ − target) d and D = σ' d².
+ * Returns (σ − target)/σ'; sets l->inv = 1/σ'. */
+static inline double correction(const law_t *law, layer_t *l, double eps, int up, double target)
 {
     double u = eps - l->er[up], d = l->d0[up] + (up ? u : -u), e2 = eps * eps;
     double rest = law->two_mu * eps * (1.0 + law->beta * e2) + l->z + law->b * (eps - l->eps_c)
                   + l->sr[up] - target;
     double slope = law->two_mu * (1.0 + 3.0 * law->beta * e2) + law->b;
     double w = d / (slope * d * d + l->num[up] * l->d0[up]);
-    *inv = d * w;
+    l->inv = d * w;
     return (rest * d + u * l->num[up]) * w;
 }
 
@@ -250,7 +251,7 @@ static void prepare_layer(layer_t *l, const law_t *law, const double *layer, con
     }
 }
 
-/* the layer's state after the step, ending at strain eps */
+/* the layer's state after the step, ending at strain eps (its friction stress l->fr if known) */
 /* the exponentials' states after the step, in place or into another buffer (no overlap); in
  * pairs (the compiler's vector instructions at -O2) */
 static void decay_in_place(double *restrict z, const double *restrict decay, double step, int J)
@@ -277,7 +278,7 @@ static void decay_into(double *restrict out, const double *restrict z,
 }
 
 static void commit_layer(const layer_t *l, const double *layer, double *out, double eps,
-                         const double *decay, int J, const double *friction)
+                         const double *decay, int J, int known)
 {
     double step = eps - l->eps_c;
     if (out == layer)
@@ -294,7 +295,7 @@ static void commit_layer(const layer_t *l, const double *layer, double *out, dou
     out[BK_LAYER_EPS_S] = l->er[up];
     out[BK_LAYER_SIG_S] = l->sr[up];
     out[BK_LAYER_DIR] = up ? 1.0 : -1.0;
-    out[BK_LAYER_SIG_F] = friction ? *friction : l->sr[up] + u * (l->num[up] / (l->d0[up] + (up ? u : -u)));
+    out[BK_LAYER_SIG_F] = known ? l->fr : l->sr[up] + u * (l->num[up] / (l->d0[up] + (up ? u : -u)));
     out[BK_LAYER_EPS] = eps;
 }
 
@@ -333,7 +334,7 @@ static int series_newton(const law_t *law, layer_t *L, const double *layer, size
                 double t = l->p * F - l->at_c;
                 if (t != 0.0) l->up = t > 0.0;
             }
-            double ri = correction(law, l, l->eps, l->up, l->p * F, &l->inv);
+            double ri = correction(law, l, l->eps, l->up, l->p * F);
             if (!isfinite(ri) || !(l->inv > 0.0)) return 1;
             l->r = ri;
             g += l->eps * l->ic;
@@ -485,7 +486,7 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
             return fail(message, length, text);
         }
     }
-    double *decay = work + WORK_HEAD, *gd = decay + J, *pc = gd + J;
+    double *decay = work + WORK_HEAD, *gd = decay + J, *stiff = gd + J, *pc = stiff + BK_CHANNELS;
     layer_t *L = (layer_t *)(pc + 4 * all_layers(sizes));
     if (work[WORK_H] != h) {  /* once per step size (and after bk_work_reset) */
         double b = 0.0;
@@ -500,12 +501,15 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
         for (int c = 0; c < BK_CHANNELS; c++) {
             int n = sizes->layers[c];
             const double *S = p + bk_channel_parameters(sizes, c), *cf = S + n;
+            double soft = 0.0;  /* the channel's elastic compliance, for the load's scale */
             for (int k = 0; k < n; k++, at += 4) {
                 at[0] = 2.0 * cf[k] / S[k];
                 at[1] = S[k] / (2.0 * cf[k]);
                 at[2] = cf[k];
                 at[3] = 1.0 / cf[k];
+                soft += at[0] * at[3];
             }
+            stiff[c] = 1.0 / (cf[n] + soft / (2.0 * p[BK_MU] + work[WORK_B]));
         }
     }
     law_t law = {2.0 * p[BK_MU], p[BK_BETA], work[WORK_B]};
@@ -516,7 +520,8 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
         double compliance = p[bk_channel_parameters(sizes, c) + 2 * (size_t)n];
         const double *ch = state + bk_channel_state(sizes, c);
         double *out = next + bk_channel_state(sizes, c);
-        double load = ch[BK_CHANNEL_F], friction, *known = NULL;
+        double load = ch[BK_CHANNEL_F];
+        int known = 0;
         for (int k = 0; k < n; k++) {
             prepare_layer(&L[k], &law, ch + BK_CHANNEL_HEAD + k * layer_size, gd, J, smax,
                           ehalf_smax, ehalf);
@@ -530,14 +535,11 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
             /* one layer, no bulk spring: its strain is the drive's, the load follows */
             double slope, eps = x[c] * L[0].c;
             L[0].eps = eps;
-            load = stress(&law, &L[0], eps, eps > L[0].eps_c, &slope, &friction) * L[0].ip;
-            known = &friction;
+            load = stress(&law, &L[0], eps, eps > L[0].eps_c, &slope, &L[0].fr) * L[0].ip;
+            known = 1;
             if (evaluations) (*evaluations)++;
         } else {
-            double soft = 0.0;  /* the channel's elastic compliance, for the load's scale */
-            for (int k = 0; k < n; k++) soft += L[k].ic * L[k].p;
-            soft = compliance + soft / (law.two_mu + law.b);
-            double scale = larger(fabs(load), (fabs(x[c]) + fabs(ch[BK_CHANNEL_X])) / soft);
+            double scale = larger(fabs(load), (fabs(x[c]) + fabs(ch[BK_CHANNEL_X])) * stiff[c]);
             double change = x[c] - ch[BK_CHANNEL_X], ratio = change / ch[BK_CHANNEL_STEP];
             if (!(fabs(ratio) <= GUESS_RATIO)) ratio = 0.0;  /* also 0/0: held, or from rest */
 #ifndef BK_SERIES_NESTED_ONLY
