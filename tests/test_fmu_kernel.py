@@ -1,17 +1,20 @@
 """The FMU's C kernel alone (fmu/c/bushing_kernel.c, through ctypes) against a NumPy/SciPy
 reference written here from docs/element.md: the held-input step, the exact exponential update,
-the series layers with a bulk spring, Berg friction with its reversal memory; and its cost per
-step, which does not grow with the history."""
+the series layers with a bulk spring, Berg friction with its reversal memory; its two series
+solves (the one-level Newton and the nested fallback, built alone) against each other on hard
+steps; and its cost per step, which does not grow with the history."""
 
 from __future__ import annotations
 
 import shutil
+import subprocess
 
 import numpy as np
 import pytest
 from scipy.optimize import brentq
 
 from core import PAPER_B
+from fmu.build import c_sources, find_compiler
 from fmu.description import CHANNELS
 from tests.fmu_helpers import Kernel, coefficients_of, compile_kernel
 
@@ -21,6 +24,15 @@ pytestmark = pytest.mark.skipif(shutil.which("cc") is None, reason="needs a C co
 @pytest.fixture(scope="module")
 def library(tmp_path_factory):
     return compile_kernel(tmp_path_factory.mktemp("kernel"))
+
+
+@pytest.fixture(scope="module")
+def nested_library(tmp_path_factory):
+    """The kernel with its fallback series solve alone (the nested, bracketed Newton)."""
+    src, out = c_sources(), tmp_path_factory.mktemp("nested") / "nested.so"
+    subprocess.run([find_compiler(), "-std=c99", "-O2", "-fPIC", "-shared", "-DBK_SERIES_NESTED_ONLY", "-I",
+                    str(src), str(src / "bushing_kernel.c"), "-o", str(out), "-lm"], check=True, capture_output=True)
+    return out
 
 
 def rich_coefficients():
@@ -113,9 +125,10 @@ def history(n, seed=3):
     return np.diff(np.concatenate(([0.0], t))), x
 
 
-def test_the_kernel_matches_the_reference_of_the_spec_along_one_history(library):
+@pytest.mark.parametrize("solve", ["one-level Newton", "nested fallback"])
+def test_the_kernel_matches_the_reference_of_the_spec_along_one_history(library, nested_library, solve):
     co = rich_coefficients()
-    kernel, reference = Kernel(library, co), Reference(co)
+    kernel, reference = Kernel(library if solve == "one-level Newton" else nested_library, co), Reference(co)
     steps, drive = history(120)
     worst = 0.0
     for h, x in zip(steps, drive, strict=True):
@@ -124,6 +137,41 @@ def test_the_kernel_matches_the_reference_of_the_spec_along_one_history(library)
     assert worst < 1e-9
     # the friction memory was exercised: some layer has reversed
     assert any(ly.dir != 0 and ly.eps_s != 0 for lys in reference.layers.values() for ly in lys)
+
+
+def hard_history(n, seed=5):
+    """Steps that trouble a Newton: held inputs (the layers move by relaxation alone), jumps many
+    times the last step (no extrapolation), dithers of 1e-6 of the amplitude about a reversal
+    (friction's kink), returns to rest, and a run of 3 slices' worth of smooth steps between."""
+    steps, drive = history(n, seed)
+    rng = np.random.default_rng(seed)
+    for i in range(8, n - 6, 12):
+        kind = rng.integers(4)
+        if kind == 0:
+            drive[i:i + 4] = drive[i - 1]
+        elif kind == 1:
+            drive[i] = -3.0 * drive[i - 1]
+        elif kind == 2:
+            drive[i:i + 5] = drive[i - 1] * (1.0 + 1e-6 * np.array([1, -1, 1, -1, 1]))[:, None]
+        else:
+            drive[i:i + 2] = 0.0
+    return steps, drive
+
+
+def test_the_one_level_newton_and_the_nested_solve_agree_on_hard_steps(library, nested_library):
+    """The fast series solve (one Newton over the layers' strains and the load, from an
+    extrapolated guess) and the fallback (Newton on the load, each layer bracketed) reach the
+    same solution, step after step, where the guess is poor or the kink is in the way."""
+    co = rich_coefficients()
+    co["dz"]["S"], co["dz"]["c"] = co["dz"]["S"] * 2, co["dz"]["c"] * 2  # 4 layers
+    fast, nested = Kernel(library, co), Kernel(nested_library, co)
+    steps, drive = hard_history(240)
+    worst = 0.0
+    for h, x in zip(steps, drive, strict=True):
+        ff, fn = fast.step(x, h), nested.step(x, h)
+        worst = max(worst, float(np.max(np.abs(ff - fn) / np.maximum(np.abs(fn), 1e-6 * np.abs(fn).max() + 1e-300))))
+    assert worst < 1e-11, f"largest relative difference {worst:.2e}"
+    assert fast.evaluations.value < nested.evaluations.value  # the fast solve did its own work
 
 
 def test_a_trial_leaves_the_state_and_gives_what_the_commit_gives(library):
