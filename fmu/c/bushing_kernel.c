@@ -221,10 +221,10 @@ static inline double correction(const law_t *law, layer_t *l, double eps, int up
 }
 
 /* the layer's law for this step from its committed state: the memory's stress (four partial
- * sums: no chain of J dependent additions) and both friction branches (without friction,
- * σ_fmax = 0, the branches are flat at σ_r = 0) */
+ * sums: no chain of J dependent additions) and the friction branches, both (`only` < 0) or one
+ * (without friction, σ_fmax = 0, the branches are flat at σ_r = 0) */
 static void prepare_layer(layer_t *l, const law_t *law, const double *layer, const double *gd,
-                          int J, double smax, double ehalf_smax, double ehalf)
+                          int J, double smax, double ehalf_smax, double ehalf, int only)
 {
     const double *z = layer + BK_LAYER_HEAD;
     double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
@@ -241,7 +241,7 @@ static void prepare_layer(layer_t *l, const law_t *law, const double *layer, con
     l->sig_c = layer[BK_LAYER_SIG_F];
     l->dir = layer[BK_LAYER_DIR];
     l->at_c = law->two_mu * l->eps_c * (1.0 + law->beta * l->eps_c * l->eps_c) + l->z + l->sig_c;
-    for (int up = 0; up < 2; up++) {
+    for (int up = only < 0 ? 0 : only; up < (only < 0 ? 2 : only + 1); up++) {
         double s = up ? 1.0 : -1.0;
         int on = l->dir == s;  /* on along its direction from its last reversal, or reversing */
         l->er[up] = on ? layer[BK_LAYER_EPS_S] : l->eps_c;
@@ -251,7 +251,6 @@ static void prepare_layer(layer_t *l, const law_t *law, const double *layer, con
     }
 }
 
-/* the layer's state after the step, ending at strain eps (its friction stress l->fr if known) */
 /* the exponentials' states after the step, in place or into another buffer (no overlap); in
  * pairs (the compiler's vector instructions at -O2) */
 static void decay_in_place(double *restrict z, const double *restrict decay, double step, int J)
@@ -277,6 +276,7 @@ static void decay_into(double *restrict out, const double *restrict z,
     if (j < J) out[j] = decay[j] * (z[j] + step);
 }
 
+/* the layer's state after the step, ending at strain eps (its friction stress l->fr if known) */
 static void commit_layer(const layer_t *l, const double *layer, double *out, double eps,
                          const double *decay, int J, int known)
 {
@@ -522,16 +522,18 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
         double *out = next + bk_channel_state(sizes, c);
         double load = ch[BK_CHANNEL_F];
         int known = 0;
+        int direct = n == 1 && compliance == 0.0;  /* the strain is the drive's */
         for (int k = 0; k < n; k++) {
-            prepare_layer(&L[k], &law, ch + BK_CHANNEL_HEAD + k * layer_size, gd, J, smax,
-                          ehalf_smax, ehalf);
+            const double *layer = ch + BK_CHANNEL_HEAD + k * layer_size;
+            prepare_layer(&L[k], &law, layer, gd, J, smax, ehalf_smax, ehalf,
+                          direct ? x[c] * pc[2] > layer[BK_LAYER_EPS] : -1);
             L[k].p = pc[0];
             L[k].ip = pc[1];
             L[k].c = pc[2];
             L[k].ic = pc[3];
             pc += 4;
         }
-        if (n == 1 && compliance == 0.0) {
+        if (direct) {
             /* one layer, no bulk spring: its strain is the drive's, the load follows */
             double slope, eps = x[c] * L[0].c;
             L[0].eps = eps;
