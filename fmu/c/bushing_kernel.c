@@ -515,11 +515,14 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
     law_t law = {2.0 * p[BK_MU], p[BK_BETA], work[WORK_B]};
     double smax = p[BK_SIGMA_F_MAX], ehalf = p[BK_EPS_HALF];
     double ehalf_smax = smax > 0.0 ? ehalf / smax : 0.0;
+    size_t at_p = bk_channel_parameters(sizes, 0), at_s = 0;  /* the channel's offsets */
     for (int c = 0; c < BK_CHANNELS; c++) {
         int n = sizes->layers[c];
-        double compliance = p[bk_channel_parameters(sizes, c) + 2 * (size_t)n];
-        const double *ch = state + bk_channel_state(sizes, c);
-        double *out = next + bk_channel_state(sizes, c);
+        double compliance = p[at_p + 2 * (size_t)n];
+        const double *ch = state + at_s;
+        double *out = next + at_s;
+        at_p += 2 * (size_t)n + 1;
+        at_s += BK_CHANNEL_HEAD + (size_t)n * layer_size;
         double load = ch[BK_CHANNEL_F];
         int known = 0;
         int direct = n == 1 && compliance == 0.0;  /* the strain is the drive's */
