@@ -48,7 +48,6 @@ typedef struct {
     double p, ip, c, ic;       /* p = 2c/S, 1/p, c and 1/c */
     double er[2], sr[2], num[2], d0[2];  /* each branch's reversal point, σ_fmax − sσ_r, d_0 */
     double eps, r, inv;        /* the iterate, its correction (σ − pF)/σ', 1/σ' there */
-    double fr;                 /* the friction stress at the final strain (one-layer path) */
     int up;                    /* the iterate's branch */
 } layer_t;
 #define LAYER_DOUBLES ((sizeof(layer_t) + sizeof(double) - 1) / sizeof(double))
@@ -196,14 +195,13 @@ typedef struct {
 
 /* the layer's stress σ(ε) and slope dσ/dε on branch `up`: elastic, memory (its stress at ε_c plus
  * B(ε − ε_c)) and Berg friction σ_r + u(σ_fmax − sσ_r)/(d_0 + su), u = ε − ε_r */
-static inline double stress(const law_t *law, const layer_t *l, double eps, int up, double *slope,
-                            double *friction)
+static inline double stress(const law_t *law, const layer_t *l, double eps, int up, double *slope)
 {
     double u = eps - l->er[up], w = 1.0 / (l->d0[up] + (up ? u : -u)), q = l->num[up] * w;
     double e2 = eps * eps;
     *slope = law->two_mu * (1.0 + 3.0 * law->beta * e2) + law->b + q * l->d0[up] * w;
-    *friction = l->sr[up] + u * q;
-    return law->two_mu * eps * (1.0 + law->beta * e2) + l->z + law->b * (eps - l->eps_c) + *friction;
+    return law->two_mu * eps * (1.0 + law->beta * e2) + l->z + law->b * (eps - l->eps_c)
+           + l->sr[up] + u * q;
 }
 
 /* Newton's correction of the layer's strain for the stress target, in one division: with
@@ -220,13 +218,10 @@ static inline double correction(const law_t *law, layer_t *l, double eps, int up
     return (rest * d + u * l->num[up]) * w;
 }
 
-/* the layer's law for this step from its committed state: the memory's stress (four partial
- * sums: no chain of J dependent additions) and the friction branches, both (`only` < 0) or one
- * (without friction, σ_fmax = 0, the branches are flat at σ_r = 0) */
-static void prepare_layer(layer_t *l, const law_t *law, const double *layer, const double *gd,
-                          int J, double smax, double ehalf_smax, double ehalf, int only)
+/* the memory's stress Σ m g_j e^{−λ_j h} z_j, in four partial sums (no chain of J dependent
+ * additions) */
+static inline double memory_stress(const double *gd, const double *z, int J)
 {
-    const double *z = layer + BK_LAYER_HEAD;
     double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
     int j = 0;
     for (; j + 4 <= J; j += 4) {
@@ -236,18 +231,51 @@ static void prepare_layer(layer_t *l, const law_t *law, const double *layer, con
         s3 += gd[j + 3] * z[j + 3];
     }
     for (; j < J; j++) s0 += gd[j] * z[j];
-    l->z = (s0 + s1) + (s2 + s3);
+    return (s0 + s1) + (s2 + s3);
+}
+
+/* Berg's friction stress on a branch, u = ε − ε_r along it (s: its direction) */
+static inline double berg(double sr, double num, double d0, double s, double u)
+{
+    return sr + u * (num / (d0 + s * u));
+}
+
+/* the friction branch a layer moves on in direction s from its committed state: on along its
+ * direction from its last reversal point, or reversing at the committed point; its reversal
+ * point (ε_r, σ_r), σ_fmax − sσ_r and d_0 = ε½(1 − sσ_r/σ_fmax) (without friction, σ_fmax = 0,
+ * the branch is flat at σ_r = 0) */
+typedef struct {
+    double er, sr, num, d0;
+} branch_t;
+
+static inline branch_t branch(const double *layer, double s, double smax, double ehalf_smax,
+                              double ehalf)
+{
+    branch_t b;
+    int on = layer[BK_LAYER_DIR] == s;
+    b.er = on ? layer[BK_LAYER_EPS_S] : layer[BK_LAYER_EPS];
+    b.sr = on ? layer[BK_LAYER_SIG_S] : layer[BK_LAYER_SIG_F];
+    b.num = smax > 0.0 ? smax - s * b.sr : 0.0;
+    b.d0 = smax > 0.0 ? ehalf - s * b.sr * ehalf_smax : 1.0;
+    return b;
+}
+
+/* the layer's law for this step from its committed state: the memory's stress and both
+ * friction branches */
+static void prepare_layer(layer_t *l, const law_t *law, const double *layer, const double *gd,
+                          int J, double smax, double ehalf_smax, double ehalf)
+{
+    l->z = memory_stress(gd, layer + BK_LAYER_HEAD, J);
     l->eps_c = layer[BK_LAYER_EPS];
     l->sig_c = layer[BK_LAYER_SIG_F];
     l->dir = layer[BK_LAYER_DIR];
     l->at_c = law->two_mu * l->eps_c * (1.0 + law->beta * l->eps_c * l->eps_c) + l->z + l->sig_c;
-    for (int up = only < 0 ? 0 : only; up < (only < 0 ? 2 : only + 1); up++) {
-        double s = up ? 1.0 : -1.0;
-        int on = l->dir == s;  /* on along its direction from its last reversal, or reversing */
-        l->er[up] = on ? layer[BK_LAYER_EPS_S] : l->eps_c;
-        l->sr[up] = on ? layer[BK_LAYER_SIG_S] : l->sig_c;
-        l->num[up] = smax > 0.0 ? smax - s * l->sr[up] : 0.0;
-        l->d0[up] = smax > 0.0 ? ehalf - s * l->sr[up] * ehalf_smax : 1.0;
+    for (int up = 0; up < 2; up++) {
+        branch_t b = branch(layer, up ? 1.0 : -1.0, smax, ehalf_smax, ehalf);
+        l->er[up] = b.er;
+        l->sr[up] = b.sr;
+        l->num[up] = b.num;
+        l->d0[up] = b.d0;
     }
 }
 
@@ -276,9 +304,9 @@ static void decay_into(double *restrict out, const double *restrict z,
     if (j < J) out[j] = decay[j] * (z[j] + step);
 }
 
-/* the layer's state after the step, ending at strain eps (its friction stress l->fr if known) */
+/* the layer's state after the step, ending at strain eps */
 static void commit_layer(const layer_t *l, const double *layer, double *out, double eps,
-                         const double *decay, int J, int known)
+                         const double *decay, int J)
 {
     double step = eps - l->eps_c;
     if (out == layer)
@@ -295,7 +323,7 @@ static void commit_layer(const layer_t *l, const double *layer, double *out, dou
     out[BK_LAYER_EPS_S] = l->er[up];
     out[BK_LAYER_SIG_S] = l->sr[up];
     out[BK_LAYER_DIR] = up ? 1.0 : -1.0;
-    out[BK_LAYER_SIG_F] = known ? l->fr : l->sr[up] + u * (l->num[up] / (l->d0[up] + (up ? u : -u)));
+    out[BK_LAYER_SIG_F] = berg(l->sr[up], l->num[up], l->d0[up], up ? 1.0 : -1.0, u);
     out[BK_LAYER_EPS] = eps;
 }
 
@@ -388,11 +416,11 @@ static double bracketed(double x, double step, double lo, double hi)
  * Newton from the layer's last iterate); l->eps, l->inv = 1/σ' there */
 static int layer_strain(const law_t *law, layer_t *l, double target, long *count)
 {
-    double eps_c = l->eps_c, slope, eps, friction;
+    double eps_c = l->eps_c, slope, eps;
     int up = target > l->at_c;
     if (target == l->at_c) {
         l->eps = eps_c;
-        stress(law, l, eps_c, l->dir >= 0.0, &slope, &friction);
+        stress(law, l, eps_c, l->dir >= 0.0, &slope);
         l->inv = 1.0 / slope;
         return 0;
     }
@@ -400,11 +428,11 @@ static int layer_strain(const law_t *law, layer_t *l, double target, long *count
     if (l->eps > lo && l->eps < hi) {
         eps = l->eps;
     } else {
-        stress(law, l, eps_c, up, &slope, &friction);
+        stress(law, l, eps_c, up, &slope);
         eps = eps_c + (target - l->at_c) / slope;
     }
     for (int i = 0; i < MAX_ITERATIONS; i++) {
-        double r = stress(law, l, eps, up, &slope, &friction) - target;
+        double r = stress(law, l, eps, up, &slope) - target;
         if (count) (*count)++;
         if (!isfinite(r) || !(slope > 0.0)) return 1;
         if (r == 0.0) break;
@@ -424,7 +452,7 @@ static int layer_strain(const law_t *law, layer_t *l, double target, long *count
         if (i == MAX_ITERATIONS - 1) return 1;
     }
     if (up ? eps < eps_c : eps > eps_c) eps = eps_c;  /* never across the reversal */
-    stress(law, l, eps, up, &slope, &friction);
+    stress(law, l, eps, up, &slope);
     l->eps = eps;
     l->inv = 1.0 / slope;
     return 0;
@@ -463,6 +491,35 @@ static int series_nested(const law_t *law, layer_t *L, int n, double cb, double 
     }
     *load = F;
     return 0;
+}
+
+/* a layer alone with the drive (no bulk spring): its strain c·x is known, its load σ S/(2c)
+ * follows in one evaluation, in registers; its state after the step into `out` */
+static double direct_layer(const law_t *law, const double *layer, double *out, double x,
+                           const double *pc, const double *gd, const double *decay, int J,
+                           double smax, double ehalf_smax, double ehalf)
+{
+    double eps = x * pc[2], eps_c = layer[BK_LAYER_EPS], step = eps - eps_c;
+    double s = step > 0.0 ? 1.0 : -1.0, e2 = eps * eps;
+    branch_t b = branch(layer, s, smax, ehalf_smax, ehalf);
+    double fr = berg(b.sr, b.num, b.d0, s, eps - b.er);
+    double sigma = law->two_mu * eps * (1.0 + law->beta * e2)
+                   + memory_stress(gd, layer + BK_LAYER_HEAD, J) + law->b * step + fr;
+    if (out == layer)
+        decay_in_place(out + BK_LAYER_HEAD, decay, step, J);
+    else
+        decay_into(out + BK_LAYER_HEAD, layer + BK_LAYER_HEAD, decay, step, J);
+    out[BK_LAYER_STEP] = step;
+    if (step == 0.0) {
+        if (out != layer) memcpy(out, layer, BK_LAYER_STEP * sizeof(double));
+    } else {
+        out[BK_LAYER_EPS_S] = b.er;
+        out[BK_LAYER_SIG_S] = b.sr;
+        out[BK_LAYER_DIR] = s;
+        out[BK_LAYER_SIG_F] = fr;
+        out[BK_LAYER_EPS] = eps;
+    }
+    return sigma * pc[1];
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -524,41 +581,45 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
         at_p += 2 * (size_t)n + 1;
         at_s += BK_CHANNEL_HEAD + (size_t)n * layer_size;
         double load = ch[BK_CHANNEL_F];
-        int known = 0;
-        int direct = n == 1 && compliance == 0.0;  /* the strain is the drive's */
+        if (n == 1 && compliance == 0.0) {
+            /* one layer, no bulk spring: its strain is the drive's, the load follows */
+            f[c] = direct_layer(&law, ch + BK_CHANNEL_HEAD, out + BK_CHANNEL_HEAD, x[c], pc, gd,
+                                decay, J, smax, ehalf_smax, ehalf);
+            if (evaluations) (*evaluations)++;
+            if (!isfinite(f[c])) {
+                snprintf(text, sizeof text, "channel %s: the force is not finite (drive %g)",
+                         CHANNEL_NAMES[c], x[c]);
+                return fail(message, length, text);
+            }
+            out[BK_CHANNEL_STEP] = x[c] - ch[BK_CHANNEL_X];
+            out[BK_CHANNEL_X] = x[c];
+            out[BK_CHANNEL_F] = f[c];
+            pc += 4;
+            continue;
+        }
         for (int k = 0; k < n; k++) {
-            const double *layer = ch + BK_CHANNEL_HEAD + k * layer_size;
-            prepare_layer(&L[k], &law, layer, gd, J, smax, ehalf_smax, ehalf,
-                          direct ? x[c] * pc[2] > layer[BK_LAYER_EPS] : -1);
+            prepare_layer(&L[k], &law, ch + BK_CHANNEL_HEAD + k * layer_size, gd, J, smax,
+                          ehalf_smax, ehalf);
             L[k].p = pc[0];
             L[k].ip = pc[1];
             L[k].c = pc[2];
             L[k].ic = pc[3];
             pc += 4;
         }
-        if (direct) {
-            /* one layer, no bulk spring: its strain is the drive's, the load follows */
-            double slope, eps = x[c] * L[0].c;
-            L[0].eps = eps;
-            load = stress(&law, &L[0], eps, eps > L[0].eps_c, &slope, &L[0].fr) * L[0].ip;
-            known = 1;
-            if (evaluations) (*evaluations)++;
-        } else {
-            double scale = larger(fabs(load), (fabs(x[c]) + fabs(ch[BK_CHANNEL_X])) * stiff[c]);
-            double change = x[c] - ch[BK_CHANNEL_X], ratio = change / ch[BK_CHANNEL_STEP];
-            if (!(fabs(ratio) <= GUESS_RATIO)) ratio = 0.0;  /* also 0/0: held, or from rest */
+        double scale = larger(fabs(load), (fabs(x[c]) + fabs(ch[BK_CHANNEL_X])) * stiff[c]);
+        double change = x[c] - ch[BK_CHANNEL_X], ratio = change / ch[BK_CHANNEL_STEP];
+        if (!(fabs(ratio) <= GUESS_RATIO)) ratio = 0.0;  /* also 0/0: held, or from rest */
 #ifndef BK_SERIES_NESTED_ONLY
-            if (series_newton(&law, L, ch + BK_CHANNEL_HEAD, layer_size, n, compliance, x[c],
-                              ratio, scale, &load, evaluations))
+        if (series_newton(&law, L, ch + BK_CHANNEL_HEAD, layer_size, n, compliance, x[c],
+                          ratio, scale, &load, evaluations))
 #endif
-            {
-                load = ch[BK_CHANNEL_F];
-                if (series_nested(&law, L, n, compliance, x[c], scale, &load, evaluations, why,
-                                  sizeof why)) {
-                    snprintf(text, sizeof text, "channel %s: %s (drive %g)", CHANNEL_NAMES[c],
-                             why, x[c]);
-                    return fail(message, length, text);
-                }
+        {
+            load = ch[BK_CHANNEL_F];
+            if (series_nested(&law, L, n, compliance, x[c], scale, &load, evaluations, why,
+                              sizeof why)) {
+                snprintf(text, sizeof text, "channel %s: %s (drive %g)", CHANNEL_NAMES[c],
+                         why, x[c]);
+                return fail(message, length, text);
             }
         }
         if (!isfinite(load)) {
@@ -568,8 +629,7 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
         }
         for (int k = 0; k < n; k++) {
             const double *layer = ch + BK_CHANNEL_HEAD + k * layer_size;
-            commit_layer(&L[k], layer, out + BK_CHANNEL_HEAD + k * layer_size, L[k].eps, decay, J,
-                         known);
+            commit_layer(&L[k], layer, out + BK_CHANNEL_HEAD + k * layer_size, L[k].eps, decay, J);
         }
         out[BK_CHANNEL_STEP] = x[c] - ch[BK_CHANNEL_X];
         out[BK_CHANNEL_X] = x[c];
