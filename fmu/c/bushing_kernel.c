@@ -44,7 +44,7 @@ size_t bk_state_count(const bk_sizes *sizes)
  * [0] moving down, [1] moving up) and the series solve's iterate. Scratch, in the work buffer. */
 typedef struct {
     double eps_c, sig_c, dir;  /* committed strain, friction stress, direction (−1, 0, +1) */
-    double z, at_c;            /* Σ m g_j e^{−λ_j h} z_j: the memory's stress; σ at ε_c */
+    double z;                  /* Σ m g_j e^{−λ_j h} z_j: the memory's stress */
     double p, ip, c, ic;       /* p = 2c/S, 1/p, c and 1/c */
     double er[2], sr[2], num[2], d0[2];  /* each branch's reversal point, σ_fmax − sσ_r, d_0 */
     double eps, r, inv;        /* the iterate, its correction (σ − pF)/σ', 1/σ' there */
@@ -204,6 +204,12 @@ static inline double stress(const law_t *law, const layer_t *l, double eps, int 
            + l->sr[up] + u * q;
 }
 
+/* the layer's stress at its committed strain (both branches meet there) */
+static inline double at_rest(const law_t *law, const layer_t *l)
+{
+    return law->two_mu * l->eps_c * (1.0 + law->beta * l->eps_c * l->eps_c) + l->z + l->sig_c;
+}
+
 /* Newton's correction of the layer's strain for the stress target, in one division: with
  * d = d_0 + su, (σ − target)/σ' = N d/D and 1/σ' = d²/D, N = (σ − target) d and D = σ' d².
  * Returns (σ − target)/σ'; sets l->inv = 1/σ'. */
@@ -262,14 +268,13 @@ static inline branch_t branch(const double *layer, double s, double smax, double
 
 /* the layer's law for this step from its committed state: the memory's stress and both
  * friction branches */
-static void prepare_layer(layer_t *l, const law_t *law, const double *layer, const double *gd,
-                          int J, double smax, double ehalf_smax, double ehalf)
+static void prepare_layer(layer_t *l, const double *layer, const double *gd, int J, double smax,
+                          double ehalf_smax, double ehalf)
 {
     l->z = memory_stress(gd, layer + BK_LAYER_HEAD, J);
     l->eps_c = layer[BK_LAYER_EPS];
     l->sig_c = layer[BK_LAYER_SIG_F];
     l->dir = layer[BK_LAYER_DIR];
-    l->at_c = law->two_mu * l->eps_c * (1.0 + law->beta * l->eps_c * l->eps_c) + l->z + l->sig_c;
     for (int up = 0; up < 2; up++) {
         branch_t b = branch(layer, up ? 1.0 : -1.0, smax, ehalf_smax, ehalf);
         l->er[up] = b.er;
@@ -359,7 +364,7 @@ static int series_newton(const law_t *law, layer_t *L, const double *layer, size
             if (l->eps != l->eps_c) {
                 l->up = l->eps > l->eps_c;
             } else if (it > 0) {  /* at the kink: the side the load pushes it to */
-                double t = l->p * F - l->at_c;
+                double t = l->p * F - at_rest(law, l);
                 if (t != 0.0) l->up = t > 0.0;
             }
             double ri = correction(law, l, l->eps, l->up, l->p * F);
@@ -377,7 +382,8 @@ static int series_newton(const law_t *law, layer_t *L, const double *layer, size
         double dF = (rg - g) / dg;
         F += dF;
         if (!isfinite(F)) return 1;
-        double size = it ? fabs(dF) / larger(fabs(F), scale) : 0.0;  /* F₀: no guess */
+        /* the relative step: the largest of |δF|/scale and |δε_k|/room_k, as top/bottom */
+        double top = it ? fabs(dF) : 0.0, bottom = larger(fabs(F), scale);  /* F₀: no guess */
         int kinked = 0;
         for (int k = 0; k < n; k++) {
             layer_t *l = &L[k];
@@ -387,9 +393,10 @@ static int series_newton(const law_t *law, layer_t *L, const double *layer, size
                 kinked = 1;
             }
             double e = fabs(de), room = fabs(eps) + fabs(l->eps_c);
-            if (e > size * room) size = room > 0.0 ? e / room : INFINITY;
+            if (e * bottom > top * room || (top == 0.0 && bottom == 0.0)) top = e, bottom = room;
             l->eps = eps;
         }
+        double size = bottom > 0.0 ? top / bottom : top > 0.0 ? INFINITY : 0.0;
         if (!kinked && (size <= NEWTON_TOLERANCE
                         || (last < 1e-3 && size * (size / last) * (size / last)
                                                <= 0.01 * NEWTON_TOLERANCE))) {
@@ -417,8 +424,9 @@ static double bracketed(double x, double step, double lo, double hi)
 static int layer_strain(const law_t *law, layer_t *l, double target, long *count)
 {
     double eps_c = l->eps_c, slope, eps;
-    int up = target > l->at_c;
-    if (target == l->at_c) {
+    double at_c = at_rest(law, l);
+    int up = target > at_c;
+    if (target == at_c) {
         l->eps = eps_c;
         stress(law, l, eps_c, l->dir >= 0.0, &slope);
         l->inv = 1.0 / slope;
@@ -429,7 +437,7 @@ static int layer_strain(const law_t *law, layer_t *l, double target, long *count
         eps = l->eps;
     } else {
         stress(law, l, eps_c, up, &slope);
-        eps = eps_c + (target - l->at_c) / slope;
+        eps = eps_c + (target - at_c) / slope;
     }
     for (int i = 0; i < MAX_ITERATIONS; i++) {
         double r = stress(law, l, eps, up, &slope) - target;
@@ -598,8 +606,8 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
             continue;
         }
         for (int k = 0; k < n; k++) {
-            prepare_layer(&L[k], &law, ch + BK_CHANNEL_HEAD + k * layer_size, gd, J, smax,
-                          ehalf_smax, ehalf);
+            prepare_layer(&L[k], ch + BK_CHANNEL_HEAD + k * layer_size, gd, J, smax, ehalf_smax,
+                          ehalf);
             L[k].p = pc[0];
             L[k].ip = pc[1];
             L[k].c = pc[2];
