@@ -23,8 +23,8 @@ from pathlib import Path
 
 from .description import model_description, parameters, resource_text
 
-SOURCES = ("bushing_kernel.c", "bushing_resource.c", "bushing_fmu.c", "bushing_state.c")
-HEADERS = ("bushing_kernel.h", "bushing_resource.h", "bushing_fmu.h")
+SOURCES = ("bushing_kernel.c", "bushing_series.c", "bushing_resource.c", "bushing_fmu.c", "bushing_state.c")
+HEADERS = ("bushing_kernel.h", "bushing_series.h", "bushing_resource.h", "bushing_fmu.h")
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 DEFAULT_BAND = (0.1, 2000.0)  # Hz: docs/element.md
 TOOL = "bushing-explorer (bushing fmu)"

@@ -31,7 +31,7 @@ def nested_library(tmp_path_factory):
     """The kernel with its fallback series solve alone (the nested, bracketed Newton)."""
     src, out = c_sources(), tmp_path_factory.mktemp("nested") / "nested.so"
     subprocess.run([find_compiler(), "-std=c99", "-O2", "-fPIC", "-shared", "-DBK_SERIES_NESTED_ONLY", "-I",
-                    str(src), str(src / "bushing_kernel.c"), "-o", str(out), "-lm"], check=True, capture_output=True)
+                    str(src), str(src / "bushing_kernel.c"), str(src / "bushing_series.c"), "-o", str(out), "-lm"], check=True, capture_output=True)
     return out
 
 
