@@ -247,14 +247,8 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
             pc += 4;
             continue;
         }
-        for (int k = 0; k < n; k++) {
-            bs_prepare(&L[k], &law, ch + BK_CHANNEL_HEAD + k * layer_size, gd, J);
-            L[k].p = pc[0];
-            L[k].ip = pc[1];
-            L[k].c = pc[2];
-            L[k].ic = pc[3];
-            pc += 4;
-        }
+        bs_prepare(L, n, &law, ch + BK_CHANNEL_HEAD, layer_size, pc, gd, J);
+        pc += 4 * n;
         double scale = bs_larger(fabs(load), (fabs(x[c]) + fabs(ch[BK_CHANNEL_X])) * stiff[c]);
         double change = x[c] - ch[BK_CHANNEL_X], ratio = change / ch[BK_CHANNEL_STEP];
         if (!(fabs(ratio) <= GUESS_RATIO)) ratio = 0.0;  /* also 0/0: held, or from rest */
@@ -276,10 +270,7 @@ int bk_advance(const bk_sizes *sizes, const double *p, const double *state, doub
                      CHANNEL_NAMES[c], x[c]);
             return fail(message, length, text);
         }
-        for (int k = 0; k < n; k++) {
-            const double *layer = ch + BK_CHANNEL_HEAD + k * layer_size;
-            bs_commit(&L[k], layer, out + BK_CHANNEL_HEAD + k * layer_size, L[k].eps, decay, J);
-        }
+        bs_commit(L, n, ch + BK_CHANNEL_HEAD, out + BK_CHANNEL_HEAD, layer_size, decay, J);
         out[BK_CHANNEL_STEP] = x[c] - ch[BK_CHANNEL_X];
         out[BK_CHANNEL_X] = x[c];
         out[BK_CHANNEL_F] = load;

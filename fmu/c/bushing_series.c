@@ -89,7 +89,8 @@ static inline branch_t branch(const bs_law *law, const double *layer, double s)
 
 /* the layer's law for this step from its committed state: the memory's stress and both
  * friction branches */
-void bs_prepare(bs_layer *l, const bs_law *law, const double *layer, const double *gd, int J)
+static void prepare_layer(bs_layer *l, const bs_law *law, const double *layer, const double *gd,
+                          int J)
 {
     l->z = memory_stress(gd, layer + BK_LAYER_HEAD, J);
     l->eps_c = layer[BK_LAYER_EPS];
@@ -130,8 +131,8 @@ static void decay_into(double *restrict out, const double *restrict z,
 }
 
 /* the layer's state after the step, ending at strain eps */
-void bs_commit(const bs_layer *l, const double *layer, double *out, double eps,
-               const double *decay, int J)
+static void commit_layer(const bs_layer *l, const double *layer, double *out, double eps,
+                         const double *decay, int J)
 {
     double step = eps - l->eps_c;
     if (out == layer)
@@ -150,6 +151,25 @@ void bs_commit(const bs_layer *l, const double *layer, double *out, double eps,
     out[BK_LAYER_DIR] = up ? 1.0 : -1.0;
     out[BK_LAYER_SIG_F] = berg(l->sr[up], l->num[up], l->d0[up], up ? 1.0 : -1.0, u);
     out[BK_LAYER_EPS] = eps;
+}
+
+void bs_prepare(bs_layer *L, int n, const bs_law *law, const double *layer, size_t layer_size,
+                const double *pc, const double *gd, int J)
+{
+    for (int k = 0; k < n; k++, pc += 4) {
+        prepare_layer(&L[k], law, layer + k * layer_size, gd, J);
+        L[k].p = pc[0];
+        L[k].ip = pc[1];
+        L[k].c = pc[2];
+        L[k].ic = pc[3];
+    }
+}
+
+void bs_commit(const bs_layer *L, int n, const double *layer, double *out, size_t layer_size,
+               const double *decay, int J)
+{
+    for (int k = 0; k < n; k++)
+        commit_layer(&L[k], layer + k * layer_size, out + k * layer_size, L[k].eps, decay, J);
 }
 
 /* ------------------------------------------------------------------------------------------ */

@@ -35,12 +35,14 @@ static inline double bs_larger(double a, double b) { return a > b ? a : b; }
 double bs_direct(const bs_law *law, const double *layer, double *out, double x, const double *pc,
                  const double *gd, const double *decay, int J);
 
-/* a layer's law for the step from its committed state `layer` (its p, ip, c, ic set by the
- * caller) */
-void bs_prepare(bs_layer *l, const bs_law *law, const double *layer, const double *gd, int J);
+/* the n layers' laws for the step from their committed states (`layer`, layer_size apart;
+ * pc: each layer's 2c/S, S/(2c), c, 1/c) */
+void bs_prepare(bs_layer *L, int n, const bs_law *law, const double *layer, size_t layer_size,
+                const double *pc, const double *gd, int J);
 
-/* the layer's state after the step, ending at strain eps, into `out` (may be `layer`) */
-void bs_commit(const bs_layer *l, const double *layer, double *out, double eps,
+/* the n layers' states after the step, ending at their strains L[k].eps, into `out` (may be
+ * `layer`) */
+void bs_commit(const bs_layer *L, int n, const double *layer, double *out, size_t layer_size,
                const double *decay, int J);
 
 /* The series equations of a channel of n layers (L, prepared; `layer` its first layer's state,
