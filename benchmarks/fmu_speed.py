@@ -1,16 +1,21 @@
 """µs per step of the bushing's FMU: the C kernel alone (a loop in C, compiled here) and through
 FMPy (an FMU2Slave stepped from Python). CPU time (the machine may be shared).
 
-    PYTHONPATH=$PWD python benchmarks/fmu_speed.py
+    PYTHONPATH=$PWD python benchmarks/fmu_speed.py [--against DIR]
 
 Aim (issue 30): the C kernel ≤ 0.5 µs a step for 1–10 slices (six channels, 8–24 exponentials).
+``--against DIR`` also times the kernel sources in DIR (bushing_kernel.c/.h, and bushing_series.c
+if there) with the same loop, alternating, and prints the ratio: for instance an earlier
+commit's, ``git show COMMIT:fmu/c/bushing_kernel.c > DIR/bushing_kernel.c`` (and the .h).
 Needs a C compiler and, for the FMPy figure, fmpy.
 """
 
 from __future__ import annotations
 
+import argparse
 import ctypes
 import shutil
+import subprocess
 import sys
 import tempfile
 import time
@@ -19,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from core import PAPER_B
+from fmu.build import find_compiler
 from tests.fmu_helpers import Kernel, coefficients_of, compile_kernel
 from tests.fmu_helpers import _ptr as ptr
 
@@ -102,12 +108,26 @@ def fmpy_us(slices, steps=20_000):
     return 1e6 * cpu / steps
 
 
+def compile_other(directory: Path, sources: Path) -> Path:
+    """The kernel sources in ``sources`` with the benchmark's loop, as a shared library."""
+    (directory / "loop.c").write_text(LOOP)
+    files = [sources / name for name in ("bushing_kernel.c", "bushing_series.c") if (sources / name).exists()]
+    out = directory / "other.so"
+    subprocess.run([find_compiler(), "-std=c99", "-O2", "-fPIC", "-shared", "-I", str(sources), *map(str, files),
+                    str(directory / "loop.c"), "-o", str(out), "-lm"], check=True, capture_output=True)
+    return out
+
+
 def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--against", type=Path, help="a directory of other kernel sources to time alongside")
+    args = parser.parse_args()
     if shutil.which("cc") is None:
         print("no C compiler (cc): nothing to measure")
         return 1
     with tempfile.TemporaryDirectory() as tmp:
         library = compile_kernel(Path(tmp), extra=LOOP)
+        other = compile_other(Path(tmp), args.against) if args.against else None
         print("C kernel alone, six channels, 400 steps a period of 20 Hz, per step (CPU time; the machine "
               "may be shared; aim ≤ 0.5 µs):")
         print(f"  (the benchmark's own loop, the drive without the kernel: "
@@ -115,8 +135,12 @@ def main() -> int:
         for slices in (1, 3, 10):
             for exponentials in (8, 16, 24):
                 us, evaluations = kernel_us(library, slices, exponentials)
-                print(f"  {slices:2d} slices, {exponentials:2d} exponentials: {us:6.3f} µs "
-                      f"({evaluations:5.1f} layer-law evaluations a step)")
+                line = (f"  {slices:2d} slices, {exponentials:2d} exponentials: {us:6.3f} µs "
+                        f"({evaluations:5.1f} layer-law evaluations a step)")
+                if other:
+                    them, their = kernel_us(other, slices, exponentials)
+                    line += f"; {args.against}: {them:6.3f} µs ({their:5.1f}), {them / us:4.1f}× this"
+                print(line)
     try:
         import fmpy  # noqa: F401
     except ImportError:
