@@ -105,21 +105,10 @@ static void prepare_layer(bs_layer *l, const bs_law *law, const double *layer, c
     }
 }
 
-/* the exponentials' states after the step, in place or into another buffer (no overlap); in
- * pairs (the compiler's vector instructions at -O2) */
-static void decay_in_place(double *restrict z, const double *restrict decay, double step, int J)
-{
-    int j = 0;
-    for (; j + 2 <= J; j += 2) {
-        double a = decay[j] * (z[j] + step), b = decay[j + 1] * (z[j + 1] + step);
-        z[j] = a;
-        z[j + 1] = b;
-    }
-    if (j < J) z[j] = decay[j] * (z[j] + step);
-}
-
-static void decay_into(double *restrict out, const double *restrict z,
-                       const double *restrict decay, double step, int J)
+/* the exponentials' states after the step, e^{−λ_j h}(z_j + Δε), into `out` (`z` itself, or
+ * a buffer apart); in pairs, each pair read before it is written (the compiler's vector
+ * instructions at -O2) */
+static void decay_memory(double *out, const double *z, const double *decay, double step, int J)
 {
     int j = 0;
     for (; j + 2 <= J; j += 2) {
@@ -135,10 +124,7 @@ static void commit_layer(const bs_layer *l, const double *layer, double *out, do
                          const double *decay, int J)
 {
     double step = eps - l->eps_c;
-    if (out == layer)
-        decay_in_place(out + BK_LAYER_HEAD, decay, step, J);
-    else
-        decay_into(out + BK_LAYER_HEAD, layer + BK_LAYER_HEAD, decay, step, J);
+    decay_memory(out + BK_LAYER_HEAD, layer + BK_LAYER_HEAD, decay, step, J);
     out[BK_LAYER_STEP] = step;
     if (step == 0.0) {
         if (out != layer) memcpy(out, layer, BK_LAYER_STEP * sizeof(double));
@@ -349,10 +335,7 @@ double bs_direct(const bs_law *law, const double *layer, double *out, double x, 
     double fr = berg(b.sr, b.num, b.d0, s, eps - b.er);
     double sigma = law->two_mu * eps * (1.0 + law->beta * e2)
                    + memory_stress(gd, layer + BK_LAYER_HEAD, J) + law->b * step + fr;
-    if (out == layer)
-        decay_in_place(out + BK_LAYER_HEAD, decay, step, J);
-    else
-        decay_into(out + BK_LAYER_HEAD, layer + BK_LAYER_HEAD, decay, step, J);
+    decay_memory(out + BK_LAYER_HEAD, layer + BK_LAYER_HEAD, decay, step, J);
     out[BK_LAYER_STEP] = step;
     if (step == 0.0) {
         if (out != layer) memcpy(out, layer, BK_LAYER_STEP * sizeof(double));
