@@ -182,6 +182,7 @@ int bs_newton(const bs_law *law, bs_layer *L, const double *layer, size_t layer_
     }
     for (int it = 0; it < NEWTON_ITERATIONS; it++) {
         double g = cb * F - x, dg = cb, rg = 0.0, merit = 0.0;
+        int bad = 0;  /* a slope not positive (NaN included): checked once for all layers */
         for (int k = 0; k < n; k++) {
             bs_layer *l = &L[k];
             if (l->eps != l->eps_c) {
@@ -191,7 +192,7 @@ int bs_newton(const bs_law *law, bs_layer *L, const double *layer, size_t layer_
                 if (t != 0.0) l->up = t > 0.0;
             }
             double ri = correction(law, l, l->eps, l->up, l->p * F);
-            if (!isfinite(ri) || !(l->inv > 0.0)) return 1;
+            bad |= !(l->inv > 0.0);
             l->r = ri;
             g += l->eps * l->ic;
             dg += l->p * l->ic * l->inv;
@@ -200,7 +201,7 @@ int bs_newton(const bs_law *law, bs_layer *L, const double *layer, size_t layer_
         }
         if (count) *count += n;
         merit += fabs(g);
-        if (it >= 4 && !(merit < previous)) return 1;
+        if (bad || !isfinite(merit) || (it >= 4 && !(merit < previous))) return 1;
         previous = merit;
         double dF = (rg - g) / dg;
         F += dF;
