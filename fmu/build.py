@@ -23,8 +23,8 @@ from pathlib import Path
 
 from .description import default_step, model_description, parameters, resource_text
 
-SOURCES = ("bushing_kernel.c", "bushing_resource.c", "bushing_fmu.c", "bushing_state.c")
-HEADERS = ("bushing_kernel.h", "bushing_resource.h", "bushing_fmu.h")
+SOURCES = ("bushing_kernel.c", "bushing_series.c", "bushing_resource.c", "bushing_fmu.c", "bushing_state.c")
+HEADERS = ("bushing_kernel.h", "bushing_series.h", "bushing_resource.h", "bushing_fmu.h")
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 TOOL = "bushing-explorer (bushing fmu)"
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden")

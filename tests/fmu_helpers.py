@@ -19,10 +19,10 @@ class Sizes(ctypes.Structure):
 
 
 def compile_kernel(directory: Path, extra: str = "") -> Path:
-    """The kernel (bushing_kernel.c, plus C source ``extra`` appended) as a shared library."""
+    """The kernel (bushing_kernel.c and bushing_series.c, plus C source ``extra``) as a shared library."""
     src = c_sources()
     out = Path(directory) / "kernel.so"
-    files = [str(src / "bushing_kernel.c")]
+    files = [str(src / "bushing_kernel.c"), str(src / "bushing_series.c")]
     if extra:
         (Path(directory) / "extra.c").write_text(extra)
         files.append(str(Path(directory) / "extra.c"))

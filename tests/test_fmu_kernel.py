@@ -5,7 +5,9 @@ step, which does not grow with the history."""
 
 from __future__ import annotations
 
+import dataclasses
 import shutil
+import subprocess
 
 import numpy as np
 import pytest
@@ -13,6 +15,7 @@ from scipy.optimize import brentq
 
 from core import PAPER_B
 from core.element import CHANNELS, coefficients
+from fmu.build import c_sources, find_compiler
 from tests.fmu_helpers import Kernel, compile_kernel
 
 pytestmark = pytest.mark.skipif(shutil.which("cc") is None, reason="needs a C compiler (README's test command)")
@@ -23,16 +26,34 @@ def library(tmp_path_factory):
     return compile_kernel(tmp_path_factory.mktemp("kernel"))
 
 
+@pytest.fixture(scope="module")
+def nested_library(tmp_path_factory):
+    """The kernel with its fallback series solve alone (the nested, bracketed Newton)."""
+    src, out = c_sources(), tmp_path_factory.mktemp("nested") / "nested.so"
+    subprocess.run([find_compiler(), "-std=c99", "-O2", "-fPIC", "-shared", "-DBK_SERIES_NESTED_ONLY", "-I",
+                    str(src), str(src / "bushing_kernel.c"), str(src / "bushing_series.c"), "-o", str(out), "-lm"], check=True, capture_output=True)
+    return out
+
+
 EFFECTS = {"strain_stiffening": {"stiffening": 40.0}, "viscous": {"viscosity": 30.0}}
 # every term at work between them, with strain stiffening and viscosity in both: 2 slices axially
 # and in torsion (long shape factors); a bulk spring in series in five channels (finite shape)
 RICH = {"2 slices": (PAPER_B.replace(effects=EFFECTS), 2),
-        "a bulk spring": (PAPER_B.replace(shape="finite", bulk_modulus=2.0e8, effects=EFFECTS), 1)}
+        "a bulk spring": (PAPER_B.replace(shape="finite", bulk_modulus=2.0e8, effects=EFFECTS), 1),
+        "layers and a spring": (PAPER_B.replace(effects=EFFECTS), 2)}
+
+
+def with_channel(co, name: str, **changes):
+    """``co`` with channel ``name``'s fields changed: combinations no design makes today (layers
+    and a bulk spring in one channel), which the kernel solves all the same."""
+    return dataclasses.replace(co, channels={**co.channels, name: dataclasses.replace(co.channels[name], **changes)})
 
 
 def rich_coefficients(name="2 slices"):
     design, slices = RICH[name]
     co = coefficients(design, slices)
+    if name == "layers and a spring":  # 2 layers and a spring axially: the old hand-made case
+        return with_channel(co, "dz", compliance=0.3 / (PAPER_B.shape_factor * PAPER_B.material.shear_modulus))
     layered = [ch for ch, c in co.channels.items() if len(c.S) > 1]
     springs = [ch for ch, c in co.channels.items() if c.compliance > 0]
     assert co.beta > 0 and co.viscosity > 0 and co.rate
@@ -122,10 +143,11 @@ def history(n, seed=3):
     return np.diff(np.concatenate(([0.0], t))), x
 
 
+@pytest.mark.parametrize("solve", ["one-level Newton", "nested fallback"])
 @pytest.mark.parametrize("name", RICH)
-def test_the_kernel_matches_the_reference_of_the_spec_along_one_history(library, name):
+def test_the_kernel_matches_the_reference_of_the_spec_along_one_history(library, nested_library, name, solve):
     co = rich_coefficients(name)
-    kernel, reference = Kernel(library, co), Reference(co)
+    kernel, reference = Kernel(library if solve == "one-level Newton" else nested_library, co), Reference(co)
     steps, drive = history(120)
     worst = 0.0
     for h, x in zip(steps, drive, strict=True):
@@ -134,6 +156,41 @@ def test_the_kernel_matches_the_reference_of_the_spec_along_one_history(library,
     assert worst < 1e-9
     # the friction memory was exercised: some layer has reversed
     assert any(ly.dir != 0 and ly.eps_s != 0 for lys in reference.layers.values() for ly in lys)
+
+
+def hard_history(n, seed=5):
+    """Steps that trouble a Newton: held inputs (the layers move by relaxation alone), jumps many
+    times the last step (no extrapolation), dithers of 1e-6 of the amplitude about a reversal
+    (friction's kink), returns to rest, and a run of 3 slices' worth of smooth steps between."""
+    steps, drive = history(n, seed)
+    rng = np.random.default_rng(seed)
+    for i in range(8, n - 6, 12):
+        kind = rng.integers(4)
+        if kind == 0:
+            drive[i:i + 4] = drive[i - 1]
+        elif kind == 1:
+            drive[i] = -3.0 * drive[i - 1]
+        elif kind == 2:
+            drive[i:i + 5] = drive[i - 1] * (1.0 + 1e-6 * np.array([1, -1, 1, -1, 1]))[:, None]
+        else:
+            drive[i:i + 2] = 0.0
+    return steps, drive
+
+
+def test_the_one_level_newton_and_the_nested_solve_agree_on_hard_steps(library, nested_library):
+    """The fast series solve (one Newton over the layers' strains and the load, from an
+    extrapolated guess) and the fallback (Newton on the load, each layer bracketed) reach the
+    same solution, step after step, where the guess is poor or the kink is in the way."""
+    co = rich_coefficients("layers and a spring")
+    co = with_channel(co, "dz", S=co.channels["dz"].S * 2, c=co.channels["dz"].c * 2)  # 4 layers and a spring
+    fast, nested = Kernel(library, co), Kernel(nested_library, co)
+    steps, drive = hard_history(240)
+    worst = 0.0
+    for h, x in zip(steps, drive, strict=True):
+        ff, fn = fast.step(x, h), nested.step(x, h)
+        worst = max(worst, float(np.max(np.abs(ff - fn) / np.maximum(np.abs(fn), 1e-6 * np.abs(fn).max() + 1e-300))))
+    assert worst < 1e-11, f"largest relative difference {worst:.2e}"
+    assert fast.evaluations.value < nested.evaluations.value  # the fast solve did its own work
 
 
 def test_a_trial_leaves_the_state_and_gives_what_the_commit_gives(library):

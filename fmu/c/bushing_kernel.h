@@ -22,11 +22,13 @@
 /* the material scalars at the start of the parameter vector */
 enum { BK_MU, BK_M, BK_ALPHA, BK_SIGMA_F_MAX, BK_EPS_HALF, BK_BETA, BK_VISCOSITY, BK_SCALARS };
 
-/* per channel: the committed drive x and load F, then per layer the committed strain ε, the
- * friction reversal point (ε_s, σ_s), the direction of motion s (−1, 0 virgin, +1), the
- * friction stress σ_f at ε, and the exponentials' states z_j */
-enum { BK_CHANNEL_X, BK_CHANNEL_F, BK_CHANNEL_HEAD };
-enum { BK_LAYER_EPS, BK_LAYER_EPS_S, BK_LAYER_SIG_S, BK_LAYER_DIR, BK_LAYER_SIG_F, BK_LAYER_HEAD };
+/* per channel: the committed drive x, load F and the last step's change of x, then per layer
+ * the committed strain ε, the friction reversal point (ε_s, σ_s), the direction of motion s
+ * (−1, 0 virgin, +1), the friction stress σ_f at ε, the last step's change of ε, and the
+ * exponentials' states z_j (the two changes only guess the next step's solution) */
+enum { BK_CHANNEL_X, BK_CHANNEL_F, BK_CHANNEL_STEP, BK_CHANNEL_HEAD };
+enum { BK_LAYER_EPS, BK_LAYER_EPS_S, BK_LAYER_SIG_S, BK_LAYER_DIR, BK_LAYER_SIG_F, BK_LAYER_STEP,
+       BK_LAYER_HEAD };
 
 typedef struct {
     int exponentials;           /* J: terms of the sum of exponentials */
@@ -40,7 +42,8 @@ size_t bk_channel_parameters(const bk_sizes *sizes, int channel);  /* offset of 
 /* The state vector (doubles), as above; all zeros is the virgin state at rest. */
 size_t bk_state_count(const bk_sizes *sizes);
 size_t bk_channel_state(const bk_sizes *sizes, int channel);       /* offset of channel's x */
-/* Scratch doubles bk_advance needs; bk_work_reset before first use (it caches e^{−λh}). */
+/* Scratch doubles bk_advance needs; bk_work_reset before first use and whenever the parameters
+ * change (it caches e^{−λh} and the layers' constants by step size). */
 size_t bk_work_count(const bk_sizes *sizes);
 void bk_work_reset(const bk_sizes *sizes, double *work);
 

@@ -5,7 +5,7 @@
 #include "bushing_fmu.h"
 
 #define STATE_MAGIC "BUSHFMU"  /* 8 bytes with its terminator */
-#define STATE_VERSION 1u
+#define STATE_VERSION 2u  /* 2: the last step's changes of the drive and of each layer's strain (the Newton's first guess) */
 
 static Snapshot *new_snapshot(Instance *m)
 {
