@@ -18,9 +18,9 @@ from .bushing import (
     Route,
     check_strain,
     positive_values,
-    refuse_compressible,
     refuse_structural_effects,
 )
+from .compressible import bulk_series, steady_series_strain
 from .design import Design
 from .effects import branch_moduli
 from .parameters import MODE
@@ -165,9 +165,16 @@ def loop(
     if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 4:
         raise ValueError(f"points: must be a whole number ≥ 4, got {points!r}")
     refuse_structural_effects(design, "the branch-by-branch hysteresis loop")
-    refuse_compressible(design, "the branch-by-branch hysteresis loop")
     theta = 2.0 * np.pi * np.arange(points) / points
-    if route == "analytic":
+    series = bulk_series(design, "the hysteresis loop")
+    if series is not None:
+        if route != "analytic":
+            raise ValueError(f"route: the loop through a bulk spring in series is solved in its steady state "
+                             f"(route 'analytic'), got {route!r}")
+        _, *stresses = steady_series_strain(design, series, f, xa, points)
+        scale = series.shape_factor / (2.0 * series.strain_factor)
+        forces = tuple(scale * part for part in stresses)
+    elif route == "analytic":
         forces = loop_force(design, f, xa, theta)
     elif route == "time-domain":
         scale = force_per_stress(design)
@@ -300,7 +307,11 @@ def force_history(design: Design, displacement, dt: float) -> HistoryResult:
     if not (np.isfinite(dt) and dt > 0):
         raise ValueError(f"dt: must be a positive finite number, got {dt!r}")
     refuse_structural_effects(design, "the force history", allowed=("inertia",))
-    refuse_compressible(design, "the force history")
+    if bulk_series(design, "the force history") is not None:
+        raise ValueError("material.bulk_modulus: the force history follows the rubber's branches along the drive, and a "
+                         "bulk spring in series moves the rubber's strain off c·x at every sample (an implicit solve "
+                         "a step): the time-domain element (core.element, `bushing fmu`) solves that series step by "
+                         "step; the steady loop (core.loops.loop) honours it too")
     effects = design.effect_parameters
     scale = force_per_stress(design)
     br = mat.branch_stresses(design.material, design.strain(x), dt, effects)
