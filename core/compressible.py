@@ -84,6 +84,13 @@ def long_radial_slope(radius_ratio: float) -> float:
     return (ln + 3.0 * r) / (ln - r)
 
 
+def in_series(design: Design) -> bool:
+    """Whether ``design``'s bulk modulus acts as a spring in series (:func:`bulk_series`): K is
+    given, the direction squeezes the rubber, and its shape factor is the finite-length table's."""
+    return (design.material.bulk_modulus is not None and not pure_shear(design.mode, design.shape_kind)
+            and design.shape_kind == "finite")
+
+
 def bulk_series(design: Design, what: str = "the time-domain element") -> BulkSeries | None:
     """The series form of ``design`` in its own mode, or None where the bulk modulus is absent
     or does not act (pure shear: torsion, the long axial bushing). ValueError for the long
