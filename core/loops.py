@@ -3,7 +3,10 @@
 The drive x(t) (angle or displacement) maps to the equivalent strain ε_eq = c·x
 (:meth:`Design.strain`), the material turns that into a stress σ(t) (:mod:`core.material`), and
 the moment or force is F = S·σ / (2c) (:func:`force_per_stress`), where S is the shape factor, so
-that F = S·µ·x for a purely elastic material.
+that F = S·µ·x for a purely elastic material. A compressible rubber (a bulk modulus in a
+direction that squeezes it) is a shear layer in series with an elastic bulk spring
+(:mod:`core.compressible`): its loop is that series' steady period, the rubber's strain no
+longer c·x.
 """
 
 from __future__ import annotations
@@ -128,7 +131,11 @@ def loop(
     ellipse Im(m(iω)^α ε̂ e^{iθ}), the Berg loop of :func:`steady_friction_loop`);
     ``route="time-domain"`` simulates from rest until the steady state and returns the last
     period (the same convergence rule as the time-domain modulus). The force is F = S·σ / (2c)
-    of the material's stresses (:func:`force_per_stress`, eqs 14–18).
+    of the material's stresses (:func:`force_per_stress`, eqs 14–18). A design whose bulk
+    modulus squeezes the rubber (radial, conical, finite axial) is a shear layer in series with
+    a bulk spring (:func:`core.compressible.bulk_series`): the steady period of that series
+    (:func:`core.compressible.steady_series_strain`), the branches at the rubber's own strain,
+    by the analytic route only.
 
     Parameters
     ----------
@@ -154,10 +161,11 @@ def loop(
     ------
     ValueError
         If the frequency or amplitude is not positive, the amplitude is beyond the equivalent
-        strain :data:`core.bushing.MAX_STRAIN`, ``points`` or ``route`` is not allowed, or the
-        design has a stiffness-level effect.
+        strain :data:`core.bushing.MAX_STRAIN`, ``points`` or ``route`` is not allowed (the
+        time-domain route with a bulk spring), the design has a stiffness-level effect, or a
+        bulk modulus in the long radial direction (no series form).
     ConvergenceError
-        If the time-domain route does not reach its steady state.
+        If the time-domain route or the series solve does not reach its steady state.
     """
     f = float(positive_values("frequency_hz", frequency_hz)[0])
     xa = float(positive_values("amplitude", amplitude)[0])
@@ -294,7 +302,8 @@ def force_history(design: Design, displacement, dt: float) -> HistoryResult:
     ValueError
         If ``displacement`` is not a one-dimensional array of finite numbers, ``dt`` is not a
         positive finite number, the design has a refused effect, or it has
-        ``rate_amplitude_coupling``.
+        ``rate_amplitude_coupling``, or a bulk modulus that squeezes the rubber (the series
+        with the bulk spring is solved step by step by :mod:`core.element`).
 
     Notes
     -----
