@@ -3,7 +3,10 @@
 The drive x(t) (angle or displacement) maps to the equivalent strain ε_eq = c·x
 (:meth:`Design.strain`), the material turns that into a stress σ(t) (:mod:`core.material`), and
 the moment or force is F = S·σ / (2c) (:func:`force_per_stress`), where S is the shape factor, so
-that F = S·µ·x for a purely elastic material.
+that F = S·µ·x for a purely elastic material. A compressible rubber (a bulk modulus in a
+direction that squeezes it) is a shear layer in series with an elastic bulk spring
+(:mod:`core.compressible`): its loop is that series' steady period, the rubber's strain no
+longer c·x.
 """
 
 from __future__ import annotations
@@ -18,9 +21,9 @@ from .bushing import (
     Route,
     check_strain,
     positive_values,
-    refuse_compressible,
     refuse_structural_effects,
 )
+from .compressible import bulk_series, steady_series_strain
 from .design import Design
 from .effects import branch_moduli
 from .parameters import MODE
@@ -128,7 +131,11 @@ def loop(
     ellipse Im(m(iω)^α ε̂ e^{iθ}), the Berg loop of :func:`steady_friction_loop`);
     ``route="time-domain"`` simulates from rest until the steady state and returns the last
     period (the same convergence rule as the time-domain modulus). The force is F = S·σ / (2c)
-    of the material's stresses (:func:`force_per_stress`, eqs 14–18).
+    of the material's stresses (:func:`force_per_stress`, eqs 14–18). A design whose bulk
+    modulus squeezes the rubber (radial, conical, finite axial) is a shear layer in series with
+    a bulk spring (:func:`core.compressible.bulk_series`): the steady period of that series
+    (:func:`core.compressible.steady_series_strain`), the branches at the rubber's own strain,
+    by the analytic route only.
 
     Parameters
     ----------
@@ -154,10 +161,11 @@ def loop(
     ------
     ValueError
         If the frequency or amplitude is not positive, the amplitude is beyond the equivalent
-        strain :data:`core.bushing.MAX_STRAIN`, ``points`` or ``route`` is not allowed, or the
-        design has a stiffness-level effect.
+        strain :data:`core.bushing.MAX_STRAIN`, ``points`` or ``route`` is not allowed (the
+        time-domain route with a bulk spring), the design has a stiffness-level effect, or a
+        bulk modulus in the long radial direction (no series form).
     ConvergenceError
-        If the time-domain route does not reach its steady state.
+        If the time-domain route or the series solve does not reach its steady state.
     """
     f = float(positive_values("frequency_hz", frequency_hz)[0])
     xa = float(positive_values("amplitude", amplitude)[0])
@@ -165,9 +173,16 @@ def loop(
     if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 4:
         raise ValueError(f"points: must be a whole number ≥ 4, got {points!r}")
     refuse_structural_effects(design, "the branch-by-branch hysteresis loop")
-    refuse_compressible(design, "the branch-by-branch hysteresis loop")
     theta = 2.0 * np.pi * np.arange(points) / points
-    if route == "analytic":
+    series = bulk_series(design, "the hysteresis loop")
+    if series is not None:
+        if route != "analytic":
+            raise ValueError(f"route: the loop through a bulk spring in series is solved in its steady state "
+                             f"(route 'analytic'), got {route!r}")
+        _, *stresses = steady_series_strain(design, series, f, xa, points)
+        scale = series.shape_factor / (2.0 * series.strain_factor)
+        forces = tuple(scale * part for part in stresses)
+    elif route == "analytic":
         forces = loop_force(design, f, xa, theta)
     elif route == "time-domain":
         scale = force_per_stress(design)
@@ -287,7 +302,8 @@ def force_history(design: Design, displacement, dt: float) -> HistoryResult:
     ValueError
         If ``displacement`` is not a one-dimensional array of finite numbers, ``dt`` is not a
         positive finite number, the design has a refused effect, or it has
-        ``rate_amplitude_coupling``.
+        ``rate_amplitude_coupling``, or a bulk modulus that squeezes the rubber (the series
+        with the bulk spring is solved step by step by :mod:`core.element`).
 
     Notes
     -----
@@ -300,7 +316,11 @@ def force_history(design: Design, displacement, dt: float) -> HistoryResult:
     if not (np.isfinite(dt) and dt > 0):
         raise ValueError(f"dt: must be a positive finite number, got {dt!r}")
     refuse_structural_effects(design, "the force history", allowed=("inertia",))
-    refuse_compressible(design, "the force history")
+    if bulk_series(design, "the force history") is not None:
+        raise ValueError("material.bulk_modulus: the force history follows the rubber's branches along the drive, and a "
+                         "bulk spring in series moves the rubber's strain off c·x at every sample (an implicit solve "
+                         "a step): the time-domain element (core.element, `bushing fmu`) solves that series step by "
+                         "step; the steady loop (core.loops.loop) honours it too")
     effects = design.effect_parameters
     scale = force_per_stress(design)
     br = mat.branch_stresses(design.material, design.strain(x), dt, effects)

@@ -230,21 +230,20 @@ def test_the_command_line_fits_the_bulk_modulus_when_asked(tmp_path, capsys):
     assert "bulk_modulus" not in known["material"] and "bulk_modulus" not in known["fit"]["standard_errors"]
 
 
-def test_a_loop_is_the_material_s_and_says_so_for_a_compressible_wall():
-    """The branch-by-branch loop is the incompressible rubber's: a radial design with a bulk
-    modulus is refused by name (the stiffness honours K); torsion and the long axial bushing,
-    pure shear, draw theirs; the explorer's loop is the material model's."""
+def test_the_loop_puts_the_bulk_spring_in_series_and_the_explorer_draws_it():
+    """A radial design with a bulk modulus: the loop is no longer the incompressible rubber's
+    (tests/test_compressibility_loop.py checks its numbers); the explorer draws that loop;
+    torsion and the long axial bushing, pure shear, draw theirs unchanged."""
     from app.curves import hysteresis_loop
     from core.bushing import material_model
     from core.loops import loop
 
     radial = THIN.in_mode("radial").replace(bulk_modulus=2e9)
-    with pytest.raises(ValueError, match="material.bulk_modulus: the branch-by-branch hysteresis loop"):
-        loop(radial, 10.0, 1e-4)
-    assert material_model(radial).material.bulk_modulus is None
+    squeezed, incompressible = loop(radial, 10.0, 1e-4, 200), loop(radial.replace(bulk_modulus=None), 10.0, 1e-4, 200)
+    assert np.max(np.abs(squeezed.force - incompressible.force)) > 0.05 * np.max(np.abs(incompressible.force))
+    assert material_model(radial).material.bulk_modulus is None  # the branch-by-branch views' model
     drawn = hysteresis_loop(radial, 10.0, 0.1)
-    expected = loop(radial.replace(bulk_modulus=None), 10.0, 1e-4, 200)
-    assert np.array_equal(drawn["force"][:-1], expected.force)
+    assert np.array_equal(drawn["force"][:-1], squeezed.force)
     for mode in ("torsion", "axial"):
         design = THIN.in_mode(mode).replace(bulk_modulus=2e9)
         assert np.array_equal(loop(design, 10.0, 1e-3).force, loop(design.replace(bulk_modulus=None), 10.0, 1e-3).force)
@@ -254,6 +253,9 @@ def test_the_views_say_what_includes_the_bulk_modulus():
     from app.shapes import shape_phrase
 
     radial = shape_phrase(PAPER_B.in_mode("radial").replace(bulk_modulus=2e9))
-    assert "Bulk modulus K = 2 GPa" in radial and "the loop and the branches are the material's" in radial
+    assert "Bulk modulus K = 2 GPa" in radial and "the loss factor and the loop include it" in radial
+    assert "the branches are the material's" in radial
+    long = shape_phrase(PAPER_B.in_mode("radial").replace(shape="long", bulk_modulus=2e9))
+    assert "the loop and the branches are the material's" in long  # no series form: core.compressible
     assert "Bulk" not in shape_phrase(PAPER_B.in_mode("torsion").replace(bulk_modulus=2e9))  # pure shear
     assert "Bulk" not in shape_phrase(PAPER_B.in_mode("radial"))
