@@ -129,24 +129,35 @@ def test_a_page_closed_during_find_designs(page, served_explorer, server_log, bo
 
 
 def gate(monkeypatch, cls, where: str):
-    """``cls.compute`` held (before its work, or after it with its result in hand) until the test
-    sets ``release``: ``(started, release, ended)`` events, ``ended`` set once it has returned."""
+    """The work of ``cls`` held (before it, or after it with its result in hand) until the test
+    sets ``release``: ``(started, release, ended)`` events, ``ended`` set once it has returned.
+    The work is ``cls.compute``, or the function of the :class:`app.work.Task` that ``cls.task``
+    gives (the diagnosis: the view runs that task)."""
+    from app.work import Task
+
     started, release, ended = (threading.Event() for _ in range(3))
-    compute = cls.compute
 
-    def gated(self, progress=None):
-        try:
-            started.set()
-            if where == "before":
-                release.wait(60)
-            result = compute(self, progress)
-            if where == "after":
-                release.wait(60)
-            return result
-        finally:
-            ended.set()
+    def held(work):
+        def run(*args, **kwargs):
+            try:
+                started.set()
+                if where == "before":
+                    release.wait(60)
+                result = work(*args, **kwargs)
+                if where == "after":
+                    release.wait(60)
+                return result
+            finally:
+                ended.set()
 
-    monkeypatch.setattr(cls, "compute", gated)
+        return run
+
+    if hasattr(cls, "task"):
+        task = cls.task
+        monkeypatch.setattr(cls, "task", lambda self: (t := task(self)) and Task(held(t.function), t.args, t.kwargs))
+    else:
+        compute = cls.compute
+        monkeypatch.setattr(cls, "compute", lambda self, progress=None: held(compute)(self, progress))
     return started, release, ended
 
 
