@@ -16,7 +16,6 @@ from __future__ import annotations
 import argparse
 import ctypes
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -26,7 +25,6 @@ import numpy as np
 
 from core import PAPER_B
 from core.element import coefficients
-from fmu.build import find_compiler
 from tests.fmu_helpers import Kernel, compile_kernel
 from tests.fmu_helpers import _ptr as ptr
 
@@ -116,12 +114,7 @@ def fmpy_us(slices, steps=20_000):
 
 def compile_other(directory: Path, sources: Path) -> Path:
     """The kernel sources in ``sources`` with the benchmark's loop, as a shared library."""
-    (directory / "loop.c").write_text(LOOP)
-    files = [sources / name for name in ("bushing_kernel.c", "bushing_series.c") if (sources / name).exists()]
-    out = directory / "other.so"
-    subprocess.run([find_compiler(), "-std=c99", "-O2", "-fPIC", "-shared", "-I", str(sources), *map(str, files),
-                    str(directory / "loop.c"), "-o", str(out), "-lm"], check=True, capture_output=True)
-    return out
+    return compile_kernel(directory, LOOP, sources=sources, name="other")
 
 
 def main() -> int:

@@ -23,7 +23,8 @@ from pathlib import Path
 
 from .description import default_step, model_description, parameters, resource_text
 
-SOURCES = ("bushing_kernel.c", "bushing_series.c", "bushing_resource.c", "bushing_fmu.c", "bushing_state.c")
+KERNEL_SOURCES = ("bushing_kernel.c", "bushing_series.c")  # the element alone: no FMI in it
+SOURCES = (*KERNEL_SOURCES, "bushing_resource.c", "bushing_fmu.c", "bushing_state.c")
 HEADERS = ("bushing_kernel.h", "bushing_series.h", "bushing_resource.h", "bushing_fmu.h")
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 TOOL = "bushing-explorer (bushing fmu)"

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from core.element import CHANNEL_MODES
-from fmu.build import c_sources, find_compiler
+from fmu.build import KERNEL_SOURCES, c_sources, find_compiler
 from fmu.description import parameters
 
 
@@ -18,16 +18,19 @@ class Sizes(ctypes.Structure):
     _fields_ = [("exponentials", ctypes.c_int), ("layers", ctypes.c_int * 6)]
 
 
-def compile_kernel(directory: Path, extra: str = "") -> Path:
-    """The kernel (bushing_kernel.c and bushing_series.c, plus C source ``extra``) as a shared library."""
-    src = c_sources()
-    out = Path(directory) / "kernel.so"
-    files = [str(src / "bushing_kernel.c"), str(src / "bushing_series.c")]
+def compile_kernel(directory: Path, extra: str = "", *, sources: Path | None = None, defines: tuple = (),
+                   name: str = "kernel") -> Path:
+    """The kernel (:data:`fmu.build.KERNEL_SOURCES` from ``sources``, the package's if None, plus
+    C source ``extra``, with ``-D`` ``defines``) as a shared library ``name``.so in ``directory``:
+    the one way the tests and benchmarks/fmu_speed.py build it."""
+    src = Path(sources) if sources is not None else c_sources()
+    out = Path(directory) / f"{name}.so"
+    files = [str(src / f) for f in KERNEL_SOURCES if (src / f).exists()]
     if extra:
-        (Path(directory) / "extra.c").write_text(extra)
-        files.append(str(Path(directory) / "extra.c"))
-    subprocess.run([find_compiler(), "-std=c99", "-O2", "-fPIC", "-shared", "-I", str(src), *files,
-                    "-o", str(out), "-lm"], check=True, capture_output=True)
+        (Path(directory) / f"{name}_extra.c").write_text(extra)
+        files.append(str(Path(directory) / f"{name}_extra.c"))
+    subprocess.run([find_compiler(), "-std=c99", "-O2", "-fPIC", "-shared", *(f"-D{d}" for d in defines),
+                    "-I", str(src), *files, "-o", str(out), "-lm"], check=True, capture_output=True)
     return out
 
 

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import dataclasses
 import shutil
-import subprocess
 
 import numpy as np
 import pytest
@@ -15,7 +14,6 @@ from scipy.optimize import brentq
 
 from core import PAPER_B
 from core.element import CHANNELS, coefficients
-from fmu.build import c_sources, find_compiler
 from tests.fmu_helpers import Kernel, compile_kernel
 
 pytestmark = pytest.mark.skipif(shutil.which("cc") is None, reason="needs a C compiler (README's test command)")
@@ -29,10 +27,7 @@ def library(tmp_path_factory):
 @pytest.fixture(scope="module")
 def nested_library(tmp_path_factory):
     """The kernel with its fallback series solve alone (the nested, bracketed Newton)."""
-    src, out = c_sources(), tmp_path_factory.mktemp("nested") / "nested.so"
-    subprocess.run([find_compiler(), "-std=c99", "-O2", "-fPIC", "-shared", "-DBK_SERIES_NESTED_ONLY", "-I",
-                    str(src), str(src / "bushing_kernel.c"), str(src / "bushing_series.c"), "-o", str(out), "-lm"], check=True, capture_output=True)
-    return out
+    return compile_kernel(tmp_path_factory.mktemp("nested"), defines=("BK_SERIES_NESTED_ONLY",), name="nested")
 
 
 EFFECTS = {"strain_stiffening": {"stiffening": 40.0}, "viscous": {"viscosity": 30.0}}
