@@ -123,9 +123,30 @@ def test_the_cases_the_property_test_found_converge_and_solve_the_equations(case
         assert stress_error < 1e-9 and drive_error < 1e-9
 
 
+@pytest.mark.xfail(strict=True, raises=RuntimeError,
+                   reason="known defect of the C kernel (fmu/c/bushing_series.c, layer_strain): a strain of "
+                          "2^-149 (1.4e-45) then a drive back at zero over 0.5 s: the layer's strain does not converge")
+def test_the_kernel_after_a_tiny_strain_and_a_long_step(library):
+    """Found by the property test below with a random seed: the Python element solves it, the C
+    kernel does not yet (strict: the mark goes when the kernel is mended)."""
+    design, slices = ROBUST_DESIGNS["stiffening and viscosity, 2 slices"]
+    co = coefficients(design, slices=slices)
+    element, kernel = Element(co), Kernel(library, co)
+    x = np.zeros(6)
+    x[5] = -(2.0**-149) / design.in_mode(CHANNEL_MODES["rz"]).strain_factor
+    scale = np.full(6, 1e-300)
+    for xi, h in ((x, 1e-9), (np.zeros(6), 0.5), (np.zeros(6), 1e-9), (np.zeros(6), 2e-4)):
+        fp, fc = element.commit(xi, h), kernel.step(xi, h)
+        scale = np.maximum(scale, np.abs(fc))
+        assert np.all(np.isfinite(fp)) and np.max(np.abs(fp - fc) / scale) < 1e-6  # as the property test
+
+
 @pytest.mark.filterwarnings("ignore::core.element.ElementWarning")  # long steps warn: the numbers are the point
 @pytest.mark.parametrize("name", ROBUST_DESIGNS)
-@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+# derandomized: the same examples on every machine and run (a suite deterministic on any machine;
+# what a random search finds is kept below as plain cases)
+@settings(max_examples=20, deadline=None, derandomize=True, database=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(drive=drives())
 def test_hostile_drives_converge_to_finite_forces_that_solve_the_equations(library, name, drive):
     """Six channels at once give each one-channel element's forces within 1e-9 of the channel's
