@@ -22,10 +22,9 @@ from core.bushing import (
     stiffness_points,
 )
 from core.card import CARD_MODES, card_design
-from core.compressible import in_series
 from core.data import MeasuredLoop, MeasuredStiffness
 from core.identify.fit import folded, model_stiffness
-from core.loops import loop
+from core.loops import loop, loop_model
 from core.material import ConvergenceError
 from core.residuals import gap
 from core.response import loss_factor, magnitude_residual_pct
@@ -90,11 +89,8 @@ def amplitude_sweep(design: Design, amplitudes, frequencies) -> dict:
 def hysteresis_loop(design: Design, frequency_hz: float, amplitude: float, points: int = 200) -> dict:
     """One steady period at ``amplitude`` (display units), closed for drawing, branch by branch.
     Stiffness-level effects have no branches: the loop is the material model's, with the bulk
-    spring in series where the design has one (:func:`core.compressible.in_series`)."""
-    bulk = design.material.bulk_modulus if in_series(design) else None
-    design = material_model(design)
-    if bulk is not None:
-        design = design.replace(bulk_modulus=bulk)
+    spring in series where the design has one (:func:`core.loops.loop_model`)."""
+    design = loop_model(design)
     lp = loop(design, frequency_hz, float(units.to_si_amplitude(amplitude, design.mode)), points)
     close = np.r_[np.arange(points), 0]
     return {

@@ -20,10 +20,11 @@ from .bushing import (
     ROUTES,
     Route,
     check_strain,
+    material_model,
     positive_values,
     refuse_structural_effects,
 )
-from .compressible import bulk_series, steady_series_strain
+from .compressible import bulk_series, in_series, steady_series_strain
 from .design import Design
 from .effects import branch_moduli
 from .parameters import MODE
@@ -115,6 +116,15 @@ def steady_friction_loop(strain_amplitude: float, phase, friction_stress_max, fr
     e = np.where(rising, eps, -eps)
     branch = friction_stress_max * (1.0 - h * (1.0 + x) ** 2 / (h * (1.0 + x) + strain_amplitude + e))
     return np.where(rising, branch, -branch)
+
+
+def loop_model(design: Design) -> Design:
+    """The design whose :func:`loop` a view draws for ``design``: its material model
+    (:func:`core.bushing.material_model`: stiffness-level effects have no branches), keeping the
+    bulk modulus where it acts as a spring in series (:func:`core.compressible.in_series`), whose
+    loop :func:`loop` follows."""
+    model = material_model(design)
+    return model.replace(bulk_modulus=design.material.bulk_modulus) if in_series(design) else model
 
 
 def loop(
