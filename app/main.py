@@ -8,7 +8,7 @@ import sys
 
 import panel as pn
 
-from . import patches, work
+from . import admission, patches, work
 from .diagnosis_state import DiagnosisState
 from .export import ExportView
 from .fit_state import FitState
@@ -172,8 +172,12 @@ def _origins(address: str, port: int) -> list[str]:
     return [f"localhost:{port}", f"127.0.0.1:{port}", f"{address}:{port}", *extra]
 
 
-def serve(port: int = 5006, address: str = "localhost", show: bool = False):
-    """Start the explorer (blocking); prints the URL."""
+def serve(port: int = 5006, address: str = "localhost", show: bool = False,
+          max_sessions: int = admission.MAX_SESSIONS):
+    """Start the explorer (blocking); prints the URL. It builds one page at a time and takes at most
+    ``max_sessions`` sessions; a page beyond is told the server is busy (:mod:`app.admission`)."""
+    admission.ADMISSION.max_sessions = admission.Admission(max_sessions=max_sessions).max_sessions
+    patches.route_sessions(admission.AdmittingDocHandler, admission.AdmittingWSHandler)
     logging.basicConfig(level=logging.WARNING, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     server = pn.serve(
         create_app,

@@ -19,6 +19,12 @@ calls when a property change adds or removes models). Upstream, Bokeh's
 recompute at the last unfreeze only then (``add_root`` and ``remove_root`` would invalidate
 explicitly).
 
+**Sessions admitted** (:func:`route_sessions`). Bokeh's server takes its per-app routes from the
+module list ``bokeh.server.urls.per_app_patterns`` (which Panel rewrites with its own handlers on
+import); the explorer's server routes pages and websockets to Panel's handlers with
+:mod:`app.admission`'s check in front, so that a burst of new sessions is refused with a "busy"
+page instead of queueing on the server's one thread.
+
 **BokehJS paint** (:data:`BOKEHJS_PAINT_PATCHES`, run in the page when its document is
 ready). Three costs BokehJS 3.9 pays on every paint: a plot component's stylesheet rewritten with
 the text it already has (each rewrite makes Chromium recollect the page's styles); every visual
@@ -100,6 +106,7 @@ from pathlib import Path
 import numpy as np
 from panel.io import resources as panel_resources
 from panel.io.document import hold as panel_hold
+from panel.io.server import DocHandler, WSHandler
 from panel.models.markup import HTML as PanelHTML
 from panel.reactive import Syncable
 
@@ -135,6 +142,21 @@ def install(doc=None) -> None:
         doc.js_on_event("document_ready", CustomJS(code=UPLOAD_AT_ONCE))
         local_stylesheets(doc)
         _pages.add(doc)
+
+
+def route_sessions(doc_handler, ws_handler) -> list:
+    """Serve a new server's pages and websockets with ``doc_handler`` and ``ws_handler``
+    (subclasses of Panel's, :mod:`app.admission`): Bokeh's server reads its routes from the module
+    list ``bokeh.server.urls.per_app_patterns`` when it is made, which Panel itself rewrites with
+    its handlers on import. Call before ``pn.serve``; a test checks that the routes were Panel's.
+    Returns the routes before (to put back: ``urls.per_app_patterns[:] = previous``)."""
+    from bokeh.server import urls
+
+    previous = list(urls.per_app_patterns)
+    replace = {DocHandler: doc_handler, WSHandler: ws_handler}
+    urls.per_app_patterns[:] = [(route, replace.get(handler, handler), *rest)
+                                for route, handler, *rest in urls.per_app_patterns]
+    return previous
 
 
 def local_stylesheets(doc) -> None:

@@ -101,7 +101,9 @@ def measure(name: str, pids: list[int], url: str, routes: bool, n: int, plan: Pl
          "not_made": len([o for o in outs if o.open_s is not None]) * plan.changes - len(answers),
          "dropped": sum(o.dropped for o in outs), "rss": marks["start"][1], "rss_open": marks["opened"][1],
          "rss_end": marks["end"][1], "live": poller.times, "live_failed": poller.failures,
-         "load": (marks["start"][2], marks["end"][2]), "seconds": time.monotonic() - t0}
+         "load": (marks["start"][2], marks["end"][2]), "seconds": time.monotonic() - t0,
+         "pages": [o.page_s for o in outs if o.page_s is not None], "busy": sum(o.busy for o in outs), "busy_sessions": sum(o.busy > 0 for o in outs),
+         "busy_reasons": Counter(o.busy_reason for o in outs if o.busy_reason)}
     r["cpu_open_ms"] = 1000 * (marks["opened"][0] - marks["start"][0]) / max(1, len(opens))
     r["cpu_change_ms"] = 1000 * (marks["end"][0] - marks["opened"][0]) / max(1, len(answered))
     return r
@@ -114,8 +116,16 @@ def report(r: dict):
         print(f"  opens        {len(o)}/{r['n']}   p50 {statistics.median(o):6.2f} s   max {max(o):6.2f} s")
     else:
         print(f"  opens        0/{r['n']}")
+    if r["pages"]:
+        p = r["pages"]
+        print(f"  pages served {len(p)}/{r['n']}   p50 {statistics.median(p):6.2f} s   max {max(p):6.2f} s   "
+              f"(the session built; opened = its document then pulled by websocket)")
     for reason, count in r["errors"].most_common():
         print(f"  open errors  {count} × {reason}")
+    if r["busy"]:
+        reason = r["busy_reasons"].most_common(1)[0][0]
+        print(f"  busy         {r['busy']} refusals (HTTP 503, {reason!r}) to {r['busy_sessions']} sessions, "
+              f"each asked again after its Retry-After, as the refusal's page does")
     waiting = r["n"] - len(o) - sum(r["errors"].values())
     if waiting:
         print(f"  still opening at the time limit (no answer, no refusal): {waiting}")

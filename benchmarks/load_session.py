@@ -230,7 +230,8 @@ class Plan:
     (s) before each; a change unanswered after ``answer_timeout`` s counts as unanswered."""
     changes: int = 6
     pause: tuple[float, float] = (1.0, 3.0)
-    open_timeout: float = 20.0
+    open_timeout: float = 20.0  # the websocket's handshake (bokeh.client's default)
+    page_timeout: float = 120.0  # the page's answer (a browser waits minutes)
     answer_timeout: float = 30.0
     settle: float = 1.0  # after every session has opened: quiet this long before the changes
     settle_max: float = 30.0
@@ -246,6 +247,9 @@ class Outcome:
     answers: list = field(default_factory=list)
     dropped: bool = False
     messages: int = 0
+    page_s: float | None = None  # from the start to the page served (its session built)
+    busy: int = 0  # "server busy" refusals (HTTP 503) before the page was served
+    busy_reason: str | None = None
 
 
 class Run:
@@ -295,7 +299,13 @@ class Session(threading.Thread):
         _local.route, _local.timeout = self.route, self.run_.plan.open_timeout
         self.run_.go.wait()
         t0 = time.perf_counter()
-        session = ClientSession(websocket_url=self.ws_url)
+        try:
+            session_id = self._page()
+            self.out.page_s = time.perf_counter() - t0
+        except Exception as exc:  # noqa: BLE001 - refused, timed out: the reason is reported
+            self.out.error = f"page: {type(exc).__name__}: {exc}"[:160]
+            return
+        session = ClientSession(session_id=session_id, websocket_url=self.ws_url)
         try:
             session.pull()
         except Exception as exc:  # noqa: BLE001 - refused, timed out, closed: the reason is reported
@@ -316,6 +326,32 @@ class Session(threading.Thread):
             conn.io_loop.run_sync(lambda: self._life(session, slider))
         finally:
             conn.io_loop.close(all_fds=True)
+
+    def _page(self) -> str:
+        """The page, asked for as a browser does (the server builds the session for it): its
+        session id. A "busy" refusal (HTTP 503) is asked again after its ``Retry-After``, as the
+        refusal's page does by itself, until the run's time limit."""
+        from bokeh.util.token import get_session_id
+
+        url = "http" + self.ws_url[len("ws"):-len("ws")]
+        headers = {"Cookie": f"bushing_route={self.route}"} if self.route else {}
+        while True:
+            try:
+                request = urllib.request.Request(url, headers=headers)
+                with urllib.request.urlopen(request, timeout=self.run_.plan.page_timeout) as r:
+                    page = r.read().decode("utf-8", "replace")
+                break
+            except urllib.error.HTTPError as exc:
+                body = exc.read().decode("utf-8", "replace")
+                if exc.code != 503 or self.run_.past():
+                    raise
+                self.out.busy += 1
+                self.out.busy_reason = re.search(r"<h1>(.*?)</h1>", body).group(1) if "<h1>" in body else body[:80]
+                time.sleep(min(30.0, float(exc.headers.get("Retry-After") or 5)))
+        token = re.search(r'"token":\s*"([^"]+)"', page)
+        if token is None:
+            raise RuntimeError("no session token in the page")
+        return get_session_id(token.group(1))
 
     async def _life(self, session, slider):
         from bokeh.events import DocumentReady

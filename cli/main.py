@@ -24,6 +24,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--address", default="localhost", metavar="A",
         help="interface to listen on (default localhost; 0.0.0.0 for every interface)",
     )
+    sv.add_argument(
+        "--max-sessions", type=cli_parser._count("--max-sessions", 1, 10000), default=None, metavar="N",
+        help="sessions this process holds at once; a new page beyond is told the server is busy "
+             "(default 40, see docs/serving.md)",
+    )
     return parser
 
 
@@ -32,8 +37,9 @@ def _cmd_serve(args) -> None:
         raise InputError(f"bushing serve: --port must be at most 65535, got {args.port}")
     from app.main import serve  # Panel and the explorer: imported only when asked for
 
+    limits = {} if args.max_sessions is None else {"max_sessions": args.max_sessions}
     try:
-        serve(port=args.port, address=args.address)
+        serve(port=args.port, address=args.address, **limits)
     except OSError as exc:
         raise InputError(f"bushing serve: cannot listen on {args.address}:{args.port}: {exc.strerror}")
 

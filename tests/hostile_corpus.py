@@ -327,6 +327,8 @@ def option_cases(folder: Path, design: Path, measured: Path) -> list[Case]:
         ("diagnose --baseline magic", "diagnose {m} --design {d} --baseline elastic,magic", no("--baseline", "magic")),
         ("serve --port 70000", "serve --port 70000", no("--port", "at most 65535")),
         ("serve --port -1", "serve --port -1", no("--port", "positive")),
+        ("serve --max-sessions 0", "serve --max-sessions 0", no("--max-sessions", "at least 1")),
+        ("serve --max-sessions lots", "serve --max-sessions lots", no("--max-sessions", "whole number")),
         ("an unknown option", f"{lp} --colour red", no("unrecognized arguments", "--colour")),
         ("card without --amp-rad", "card {d} --freq 10 --amp-mm 0.1", no("--amp-rad", "required")),
         ("card at 1e300 mm", "card {d} --freq 10 --amp-mm 1e300 --amp-rad 0.01", no("amplitude", "at most")),
