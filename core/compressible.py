@@ -40,12 +40,21 @@ import numpy as np
 from .design import Design
 from .effects import branch_moduli
 from .material import ConvergenceError, elastic_stress, friction_modulus, friction_reversal_ratio
-from .shape import BULK_RATIO, pure_shear, strain_factor_from_shape, table
+from .shape import (
+    BULK_RATIO,
+    bulk_factor,
+    bulk_tangent,
+    pure_shear,
+    strain_factor_from_shape,
+    table,
+)
 
 LONG_RADIAL_REFUSAL = (
     "material.bulk_modulus: the long {mode} closed form of a compressible rubber (plane strain) has no "
     "series form (a shear layer in series with a bulk spring is up to 4.7 % off it at K/µ 50, 0.9 % at 250); "
     "{what} follows the rubber's strain through that series: use shape 'finite'")
+RUBBER_TOLERANCE = 1e-13  # on ln ε̂ of the rubber's strain amplitude (relative)
+MAX_RUBBER_ITERATIONS = 60
 SAMPLES = 2048  # at least this many samples a period inside the steady solve
 TOLERANCE = 1e-12  # relative to the drive's strain c·x̂, on the series balance
 MAX_NEWTON = 60
@@ -106,6 +115,94 @@ def bulk_series(design: Design, what: str = "the time-domain element") -> BulkSe
     g = table().slope(design.mode, b / a, L / (b - a))
     s = s0 / (1.0 - g / BULK_RATIO)
     return BulkSeries(s, strain_factor_from_shape(s, a, b, L), g / (s0 * bulk))
+
+
+# ---- the stiffness at the rubber's own strain amplitude ------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class BulkCorrection:
+    """How an elastic bulk modulus changes K = S·µ* of a design (:func:`core.bushing.bulk_correction`),
+    by the correspondence principle, at the rubber's own strain amplitude.
+
+    Attributes
+    ----------
+    geometry, mode, shape
+        The design's (:func:`core.shape.bulk_factor`'s arguments).
+    bulk_modulus : float or numpy.ndarray
+        K in Pa, broadcast against µ* (e.g. one value per sample shaped (n, 1, …)).
+    """
+
+    geometry: object
+    mode: str
+    shape: str
+    bulk_modulus: object
+
+    def factor(self, mu):
+        """S(µ*/K)/S (dimensionless) at the complex equivalent modulus µ* (Pa)."""
+        return bulk_factor(self.geometry, self.mode, self.shape, mu / self.bulk_modulus)
+
+    def strain_ratio(self, mu):
+        """ε̂/(c x̂) = |√ψ|, ψ = d(xφ)/dx at x = µ*/K (:func:`core.shape.bulk_tangent`): the
+        rubber's strain amplitude against the drive's c·x̂ (dimensionless)."""
+        return np.sqrt(np.abs(bulk_tangent(self.geometry, self.mode, self.shape, mu / self.bulk_modulus)))
+
+    def rubber_modulus(self, modulus, frequency_hz, strain):
+        """The rubber's strain amplitude ε̂ and µ*(f, ε̂) where ε̂ = ``strain``·|√ψ(µ*(f, ε̂)/K)|
+        (docs/model.md, "Compressibility"), ``strain`` = c·x̂ the drive's equivalent strain;
+        ``modulus`` is µ*(frequency_hz, strain_amplitude) in Pa, broadcast.
+
+        Solved for ln ε̂ at every point at once by the secant method, started from the fixed-point
+        step and kept inside the bracket the signs of the residual h = ln ε̂ − ln(c x̂) − ln|√ψ|
+        have shown (bisection where a step leaves it); a point stays where it is once
+        |h| ≤ :data:`RUBBER_TOLERANCE`, so a point's value does not depend on the others solved
+        with it. Where µ* does not depend on the amplitude the first step is the solution.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (ε̂, µ*): the strain amplitude (dimensionless) and the complex modulus in Pa, shaped as
+            the arguments broadcast together.
+
+        Raises
+        ------
+        ConvergenceError
+            If some point has not converged in :data:`MAX_RUBBER_ITERATIONS` steps.
+        """
+        drive = np.log(np.asarray(strain, dtype=float))
+
+        def residual(t):
+            mu = modulus(frequency_hz, np.exp(t))
+            return t - drive - np.log(self.strain_ratio(mu)), mu
+
+        h, mu = residual(drive)
+        shape = np.broadcast_shapes(np.shape(h), np.shape(mu))
+        t = np.array(np.broadcast_to(drive, shape))
+        h, mu = np.array(np.broadcast_to(h, shape)), np.array(np.broadcast_to(mu, shape))
+        lo, hi = np.full(shape, -np.inf), np.full(shape, np.inf)
+        t_old = h_old = None
+        for _ in range(MAX_RUBBER_ITERATIONS):
+            done = (np.abs(h) <= RUBBER_TOLERANCE) | ~np.isfinite(h)  # not finite: the caller says so
+            if done.all():
+                return np.exp(t), mu
+            lo, hi = np.where(h < 0, np.maximum(lo, t), lo), np.where(h > 0, np.minimum(hi, t), hi)
+            slope = np.ones(shape)
+            if t_old is not None:
+                moved = t != t_old
+                slope = np.divide(h - h_old, t - t_old, out=slope, where=moved)
+                slope = np.where(np.isfinite(slope) & (slope > 0), slope, 1.0)
+            step = t - h / slope
+            inside = (step > lo) & (step < hi)
+            both = np.isfinite(lo) & np.isfinite(hi)
+            step = np.where(inside, step, np.where(both, 0.5 * (lo + hi), np.where(np.isfinite(hi), hi - 1.0, lo + 1.0)))
+            t_new = np.where(done, t, step)
+            h_new, mu_new = residual(t_new)
+            t_old, h_old = t, h
+            t = t_new
+            h = np.where(done, h, np.broadcast_to(h_new, shape))
+            mu = np.where(done, mu, np.broadcast_to(mu_new, shape))
+        raise ConvergenceError(f"the rubber's strain amplitude through the bulk spring did not converge in "
+                               f"{MAX_RUBBER_ITERATIONS} steps (residual {float(np.nanmax(np.abs(h))):.2e})")
 
 
 # ---- one steady period of the series ------------------------------------------------------
