@@ -1,6 +1,7 @@
 """A compressible rubber as a shear layer in series with an elastic bulk spring (docs/model.md,
 "Compressibility"), for the outputs that follow the rubber's strain along a drive: the
-hysteresis loop (:mod:`core.loops`) and the time-domain element (:mod:`core.element`).
+hysteresis loop (:mod:`core.loops`) and the time-domain element (:mod:`core.element`); and the
+stiffness at the rubber's own strain amplitude (:class:`BulkCorrection`).
 
 The finite-length table's series law 1/S(x) = (1 + g(x − x₀))/S(x₀), x = µ/K,
 x₀ = 1/:data:`core.shape.BULK_RATIO`, gives the stiffness
@@ -22,6 +23,15 @@ at 250 and 0.33 % at 700; the best line over K/µ 50–10⁶ is still 2.2 % off 
 µ*). That is more than the 0.3 % the finite table's law holds, so the long radial direction with
 a bulk modulus is refused here (:data:`LONG_RADIAL_REFUSAL`) and keeps its closed form in the
 stiffness.
+
+The stiffness's first harmonic needs only the rubber's strain amplitude, and that follows from
+the energy balance for any closed form K = S·µ·φ(µ/K): the shear (deviatoric) energy is
+µ·∂K/∂µ·x̂²/2 at fixed drive (the strain field is stationary), so ε̂ = c·x̂·|√ψ(µ*/K)| with
+ψ(x) = d(xφ)/dx (:func:`core.shape.bulk_tangent`). For the table's series law this is the
+series' own ε̂ = c'x̂/|1 + C_b S'µ*|, c' the shear layer's strain factor (the force F = S'µ*x_r
+through both, x = x_r + C_b F), and K = S·µ*·φ(µ*/K) = S'µ*/(1 + C_b S'µ*); the long radial
+closed form gets its rubber's amplitude by the same rule (:meth:`BulkCorrection.rubber_modulus`
+solves it with µ* = µ_eq(f, ε̂)).
 
 :func:`steady_series_strain` solves one steady period of the series for a harmonic drive: the
 shear strain ε(θ) at every sample with ε + κσ[ε] = c x̂ sin θ, κ = C_b S/2 (1/Pa), σ[ε] the
