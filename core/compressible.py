@@ -37,7 +37,8 @@ solves it with µ* = µ_eq(f, ε̂)).
 shear strain ε(θ) at every sample with ε + κσ[ε] = c x̂ sin θ, κ = C_b S/2 (1/Pa), σ[ε] the
 rubber's three branches (the fractional one over the whole period, harmonic by harmonic; Berg's
 friction on the steady symmetric loop between ±ε̂, ε̂ = max ε), by Newton's method with the
-linear systems solved by GMRES.
+linear systems solved by GMRES. :func:`series_history_strain` solves the same balance for any
+sampled drive history, ε + κσ[ε] = c x (the force history, :func:`core.loops.force_history`).
 """
 
 from __future__ import annotations
@@ -324,3 +325,64 @@ def steady_series_strain(design: Design, series: BulkSeries, frequency_hz: float
                                "once a period")
     every = n // points
     return tuple(v[::every].copy() for v in (eps, el, ve, fr))
+
+
+# ---- any sampled history through the series ----------------------------------------------
+
+
+def series_history_strain(design: Design, series: BulkSeries, displacement, dt: float) -> np.ndarray:
+    """The rubber's shear strain at every sample of the drive history ``displacement`` (m or rad,
+    every ``dt`` s) through ``series``: ε + κσ[ε] = c x at once over the whole history, σ[ε] the
+    material's branches along it (:func:`core.material.branch_stresses`: the fractional memory
+    from rest, friction's reversals), by Newton's method with Krylov steps (finite differences of
+    σ[ε] along each direction, so friction's reversal memory is followed as it is), to
+    :data:`TOLERANCE` of the largest c|x|. Each residual is O(N log N); the steps are preconditioned
+    by the linear part at rest, 1 + κ(2µ + σ_fmax/ε½ + m D^α), the fractional derivative by its
+    Grünwald–Letnikov symbol in the frequency domain (the history padded to twice its length).
+
+    Returns
+    -------
+    numpy.ndarray
+        ε at each sample (dimensionless).
+
+    Raises
+    ------
+    ConvergenceError
+        If Newton's method does not meet the tolerance in :data:`MAX_NEWTON` iterations.
+    """
+    from scipy.optimize import NoConvergence, newton_krylov
+    from scipy.sparse.linalg import LinearOperator
+
+    from .material import branch_stresses
+
+    m = design.material
+    effects = design.effect_parameters
+    target = series.strain_factor * np.asarray(displacement, dtype=float)
+    scale = float(np.max(np.abs(target)))
+    if scale == 0.0:
+        return np.zeros_like(target)
+    kappa = series.kappa
+
+    def residual(eps):
+        br = branch_stresses(m, eps, dt, effects)
+        return eps + kappa * (br.elastic + br.fractional + br.friction) - target
+
+    # the linear part at rest, 1 + κ(2µ + σ_fmax/ε½ + m D^α), in the frequency domain: the
+    # Grünwald–Letnikov symbol dt^(−α)(1 − e^(−iω dt))^α on a grid padded to 2N (no wrap-around)
+    n = target.size
+    size = 2 * n
+    z = np.exp(-2j * np.pi * np.arange(size // 2 + 1) / size)
+    symbol = 1.0 + kappa * (2.0 * m.shear_modulus + m.friction_stress_max / m.friction_strain_half
+                            + m.fractional_coefficient * dt ** -m.fractional_order * (1.0 - z) ** m.fractional_order)
+
+    def precondition(v):
+        return np.fft.irfft(np.fft.rfft(v, size) / symbol, size)[:n]
+
+    start = precondition(target)
+    try:
+        return newton_krylov(residual, start, f_tol=TOLERANCE * scale, maxiter=MAX_NEWTON,
+                             inner_M=LinearOperator((n, n), precondition), inner_inner_m=5)
+    except NoConvergence as exc:
+        worst = float(np.max(np.abs(residual(np.asarray(exc.args[0]))))) if exc.args else float("nan")
+        raise ConvergenceError(f"the force history through the bulk spring did not converge in {MAX_NEWTON} Newton "
+                               f"iterations (residual {worst / scale:.2e} of the drive's largest strain)") from None

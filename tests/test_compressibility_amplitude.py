@@ -2,7 +2,8 @@
 at its own strain amplitude, the bulk spring's share of the drive taken off (core.compressible
 .BulkCorrection), against the series' steady loop, the series' describing function solved here
 by brentq, the closed form where µ* does not depend on the amplitude, and the incompressible
-stiffness without a bulk modulus, unchanged."""
+stiffness without a bulk modulus, unchanged; and the force history through the bulk spring against
+the time-domain element and the steady loop."""
 
 import math
 
@@ -11,6 +12,7 @@ import pytest
 from scipy.optimize import brentq
 
 from core import PAPER_B, stiffness
+from core import material as mat
 from core.bushing import (
     branch_stiffness,
     bulk_correction,
@@ -19,7 +21,9 @@ from core.bushing import (
     modulus_function,
     stiffness_points,
 )
-from core.loops import loop
+from core.compressible import bulk_series
+from core.element import Element
+from core.loops import force_history, loop
 from core.material import equivalent_modulus
 from core.shape import bulk_factor, bulk_tangent, long_radial_compressible
 from tests.test_compressibility_loop import describing_function, first_harmonic
@@ -121,3 +125,63 @@ def test_the_branches_are_taken_at_the_rubbers_amplitude_and_add_up():
     f, x = [1.0, 30.0], design.drive(np.array([1e-5, 2e-3]))
     total = sum(branch_stiffness(design, f, x).values())
     np.testing.assert_allclose(total, stiffness(design, f, x).stiffness, rtol=1e-12)
+
+
+# ---- the force history through the bulk spring -------------------------------------------
+
+
+def history(mode, tones):
+    """The issue's thin wall, 10 Hz, 1000 samples a period, 3 periods from rest: the drive
+    x̂ Σ a sin(2π r f t + φ) at ε̂ 1e-3 for ``tones`` (a, r, φ), and its force history."""
+    design = ISSUE.in_mode(mode)
+    f, steps = 10.0, 1000
+    dt = 1 / (f * steps)
+    t = dt * np.arange(1, 3 * steps + 1)
+    x = design.drive(1e-3) * sum(a * np.sin(2 * np.pi * r * f * t + p) for a, r, p in tones)
+    return design, x, dt, force_history(design, x, dt)
+
+
+@pytest.mark.filterwarnings("ignore::core.element.ElementWarning")
+@pytest.mark.parametrize("mode", ["radial", "conical"])
+def test_the_force_history_is_the_elements(mode):
+    """Two tones through the series: the whole history against the time-domain element's own
+    series solve, step by step (its fractional memory a sum of exponentials over 0.1 Hz to the
+    Nyquist frequency), within 0.5 % RMS (measured 0.12–0.14 %); the balance x = ε/c' + C_b F
+    holds at every sample."""
+    design, x, dt, h = history(mode, [(1.0, 1.0, 0.0), (0.3, 3.7, 1.0)])
+    el = Element.from_design(design, 1, band=(0.1, 0.5 / dt), channels=("dx" if mode == "radial" else "rx",))
+    element = np.array([el.commit([xi], dt)[0] for xi in x])
+    rms = np.sqrt(np.mean(h.force**2))
+    assert np.sqrt(np.mean((element - h.force) ** 2)) < 5e-3 * rms
+    s = bulk_series(design)
+    rubber = mat.branch_stresses(design.material, s.strain_factor * (x - s.compliance * h.force), dt,
+                                 design.effect_parameters)
+    scale = s.shape_factor / (2 * s.strain_factor)
+    np.testing.assert_allclose(scale * (rubber.elastic + rubber.fractional + rubber.friction), h.force,
+                               rtol=0, atol=1e-9 * np.max(np.abs(h.force)))
+
+
+@pytest.mark.parametrize("mode", ["radial", "conical"])
+def test_a_harmonic_force_history_reaches_the_steady_loop(mode):
+    """One tone: the third period against the steady loop of the series, within 0.5 % RMS less
+    the mean (measured 0.14–0.2 %: from rest the slow part of the fractional memory still
+    carries an offset), the first harmonic within 0.3 % and 0.001 in the loss factor."""
+    design, _, _, h = history(mode, [(1.0, 1.0, 0.0)])
+    steps, xa = 1000, design.drive(1e-3)
+    lp = loop(design, 10.0, xa, steps)
+    ours, last = np.roll(lp.force, -1), h.force[-steps:]  # the last period from θ = 2π/steps
+    diff = last - ours
+    assert np.sqrt(np.mean((diff - diff.mean()) ** 2)) < 5e-3 * np.sqrt(np.mean(ours**2))
+    k, k_loop = first_harmonic(np.roll(lp.phase, -1), last, xa), first_harmonic(lp.phase, lp.force, xa)
+    assert abs(abs(k) / abs(k_loop) - 1) < 3e-3 and abs(k.imag / k.real - k_loop.imag / k_loop.real) < 1e-3
+
+
+def test_without_a_bulk_modulus_the_force_history_is_as_before():
+    """No bulk modulus: F = S σ[c x]/(2c) bit for bit."""
+    design = ISSUE.replace(bulk_modulus=None).in_mode("radial")
+    x, dt = design.drive(1e-3) * np.sin(np.linspace(0, 20, 500)), 1e-3
+    br = mat.branch_stresses(design.material, design.strain(x), dt, design.effect_parameters)
+    scale = design.shape_factor / (2 * design.strain_factor)
+    h = force_history(design, x, dt)
+    assert np.array_equal(h.force_elastic, scale * br.elastic) and np.array_equal(h.force_friction, scale * br.friction)
+    assert np.array_equal(h.force_viscoelastic, scale * br.fractional)
