@@ -450,15 +450,6 @@ def material_model(design: Design) -> Design:
     return design if len(kept) == len(design.effects) else design.replace(effects=kept)
 
 
-def refuse_compressible(design: Design, what: str) -> None:
-    """ValueError if ``design``'s bulk modulus changes its stiffness (radial, conical, a finite
-    axial bushing): ``what`` is computed for the material's branches alone, and the bulk spring
-    in series is none of them."""
-    if bulk_correction(design) is not None:
-        raise ValueError(f"material.bulk_modulus: {what} is computed from the material branches of an "
-                         f"incompressible rubber; leave bulk_modulus out for it (the stiffness honours it)")
-
-
 def refuse_structural_effects(design: Design, what: str, allowed=()) -> None:
     """ValueError if ``design`` has a stiffness-level effect (:data:`STRUCTURAL_EFFECTS`) other
     than those ``allowed``: ``what`` is computed from the material branches."""

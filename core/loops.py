@@ -227,6 +227,27 @@ def loop_force(design: Design, frequency_hz: float, amplitude: float, phase):
 
 
 
+SERIES_SAMPLES = 2048  # the phases of the series' steady period a measured loop's phases are read from
+
+
+def steady_loop_force(design: Design, frequency_hz: float, amplitude: float, phase):
+    """Steady force (moment) branches at any drive phases θ, x = x̂ sin θ, of the model a
+    measured loop is compared with: (elastic, viscoelastic, friction), each in N or N·m.
+    :func:`loop_force` in closed form; where a bulk modulus acts as a spring in series
+    (:func:`core.compressible.bulk_series`), the series' steady period
+    (:func:`core.compressible.steady_series_strain`) on :data:`SERIES_SAMPLES` phases, read at
+    ``phase`` by periodic linear interpolation (within about 10⁻⁶ of the force's range).
+    ValueError for the long radial closed form with a bulk modulus (no series form)."""
+    series = bulk_series(design, "the loop's force at measured phases")
+    if series is None:
+        return loop_force(design, frequency_hz, amplitude, phase)
+    _, *stresses = steady_series_strain(design, series, frequency_hz, amplitude, SERIES_SAMPLES)
+    scale = series.shape_factor / (2.0 * series.strain_factor)
+    grid = 2.0 * np.pi * np.arange(SERIES_SAMPLES) / SERIES_SAMPLES
+    theta = np.mod(np.asarray(phase, dtype=float), 2.0 * np.pi)
+    return tuple(scale * np.interp(theta, grid, part, period=2.0 * np.pi) for part in stresses)
+
+
 def _time_domain_loop(material, effects, frequency_hz, eps_amp, points):
     """Last period of the simulated stresses, on the loop's phase grid θ = 2πk/points."""
     td = mat.equivalent_modulus_time_domain(material, frequency_hz, eps_amp, effects=effects)
