@@ -33,6 +33,21 @@ def uncached_map(slices_arg, f, x):
     return stiffness(PAPER_B, f, x, slices=slices_arg)
 
 
+def bulk_map(design, f, x):
+    """The map of a design with a bulk modulus, uncached, and how many µ* evaluations per point
+    its solve for the rubber's strain amplitude made (the last one, at the solution, included)."""
+    calls = []
+    modulus = bushing.modulus_function(design)
+
+    def counting(frequency_hz, strain):
+        calls.append(np.size(strain))
+        return modulus(frequency_hz, strain)
+
+    s, c = bushing.factors(design)
+    bushing.equivalent_stiffness(counting, s, c, f[None, :], x[:, None], bushing.bulk_correction(design))
+    return len(calls)
+
+
 def modulus_evaluations_per_point(slices_arg, f, x):
     """How many µ(ε̂) evaluations per grid point and layer the series solver makes."""
     calls = []
@@ -78,6 +93,22 @@ def main():
     cached = timed(lambda: stiffness(PAPER_B, f, x), 200)
     print(f"{'  same map again (from the cache)':<40} {cached * 1e6:>9.1f} µs")
 
+    # a thin wall (the issue's b/a 1.2, L/(b − a) 9.9) with K = 1.9 GPa: µ* at the rubber's own
+    # strain amplitude, solved at every point at once; CPU time against the same map without K
+    thin = PAPER_B.replace(inner_radius=0.02, outer_radius=0.024, length=0.0396).in_mode("radial")
+    xr = thin.drive(np.geomspace(1e-5, 1e-2, 100))
+    cpu = {}
+    for name, d in (("without K", thin), ("K 1.9 GPa", thin.replace(bulk_modulus=1.9e9))):
+        t0 = time.process_time()
+        for _ in range(10):
+            bushing._stiffness_cached.cache_clear()
+            stiffness(d, f, xr)
+        cpu[name] = (time.process_time() - t0) / 10
+    evals = bulk_map(thin.replace(bulk_modulus=1.9e9), f, xr)
+    print(f"{'100×100 radial thin-wall map, CPU':<40} {cpu['without K'] * 1e3:>9.2f} ms without K, "
+          f"{cpu['K 1.9 GPa'] * 1e3:.2f} ms with K 1.9 GPa ({cpu['K 1.9 GPa'] / cpu['without K']:.1f}×; "
+          f"{evals} µ* evaluations of the whole grid)")
+
     for name, arg, target, nodes in (
         ("100×100 map, 3 slices", 3, "≤ 50 ms", 3),
         ("100×100 map, continuum", "continuum", "≤ 200 ms", slices.continuum_node_count(PAPER_B.geometry, "axial")),
@@ -110,6 +141,16 @@ def main():
         reversals = int(np.count_nonzero(np.diff(np.sign(np.diff(signal)))))
         print(f"{name:<40} {seconds * 1e3:>9.0f} ms {'≤ 3 s':>10} {direct_est:>16.0f} s {direct_est / seconds:>10.0f}"
               f"   ({reversals} reversals)")
+    # through a bulk spring in series (the issue's thin wall, radial, K 1.9 GPa): the first 10⁵
+    # samples of the same drives, CPU time against the same history without K
+    m = 100_000
+    for name, signal in (("10⁵ samples through a bulk spring, smooth", smooth), ("  the same, noisy", noisy)):
+        cpu = []
+        for d in (thin, thin.replace(bulk_modulus=1.9e9)):
+            t0 = time.process_time()
+            force_history(d, signal[:m], dt)
+            cpu.append(time.process_time() - t0)
+        print(f"{name:<40} {cpu[1] * 1e3:>9.0f} ms CPU (without K {cpu[0] * 1e3:.0f} ms: {cpu[1] / cpu[0]:.0f}×)")
     print("\n(history reference: the direct O(N²) Grünwald–Letnikov sum, measured on 20 000 samples"
           " and scaled by N²)")
     _ = equivalent_modulus  # the analytic route used by the maps

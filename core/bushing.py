@@ -23,6 +23,7 @@ from typing import Literal
 import numpy as np
 
 from . import material as mat
+from .compressible import BulkCorrection
 from .design import Design
 from .effects import EFFECTS, branch_moduli, extended_modulus, inertia_correction, wave_stiffness
 from .parameters import MODE, THESIS_MODES
@@ -242,28 +243,35 @@ def equivalent_stiffness(modulus, s, c, frequency_hz, amplitude, bulk=None):
     :func:`modulus_function`'s, or :func:`core.material.equivalent_modulus` of a material);
     ``s`` the shape factor (m or m³/rad) and ``c`` the strain factor (1/m or 1/rad). S, c and the
     parameters inside ``modulus`` may be arrays, e.g. one value per Monte Carlo sample shaped
-    (n, 1, …) against the points; the drive ``amplitude`` is in m or rad. ``bulk``: a
-    compressible rubber's factor S(µ*/K)/S of µ_eq (:func:`bulk_correction`), or None."""
-    mu = modulus(frequency_hz, c * amplitude)  # eqs 14, 15 inside
-    return s * mu if bulk is None else s * mu * bulk(mu)  # eqs 17, 18
+    (n, 1, …) against the points; the drive ``amplitude`` is in m or rad.
+
+    ``bulk``: a compressible rubber's :class:`core.compressible.BulkCorrection`
+    (:func:`bulk_correction`), or None. Then K = S·µ*·S(µ*/K)/S with µ* = µ_eq(f, ε̂) at the
+    rubber's own strain amplitude ε̂ = c·x̂·|√ψ(µ*/K)|, solved point by point
+    (:meth:`~core.compressible.BulkCorrection.rubber_modulus`, docs/model.md "Compressibility"):
+    the bulk spring takes its share of the drive."""
+    if bulk is None:
+        return s * modulus(frequency_hz, c * amplitude)  # eqs 14, 15 inside; eqs 17, 18
+    _, mu = bulk.rubber_modulus(modulus, frequency_hz, c * amplitude)
+    return s * mu * bulk.factor(mu)
 
 
-def bulk_correction(design: Design, bulk_modulus=None):
-    """A compressible rubber's correction of K = S·µ_eq, by the correspondence principle: the
-    function µ_eq ↦ S(µ_eq/K)/S (:func:`core.shape.bulk_factor`), the complex µ_eq (the loss,
-    friction's tangent included) against the elastic bulk modulus K; None for a design without
-    ``bulk_modulus`` (nearly incompressible, K = 5000 µ: S as it is) or in a direction of pure shear
-    (:func:`core.shape.pure_shear`). ``bulk_modulus`` (Pa, may
-    be an array broadcast against µ_eq) replaces the design's."""
+def bulk_correction(design: Design, bulk_modulus=None) -> BulkCorrection | None:
+    """A compressible rubber's correction of K = S·µ_eq, by the correspondence principle
+    (:class:`core.compressible.BulkCorrection`): the factor S(µ*/K)/S
+    (:func:`core.shape.bulk_factor`) of the complex µ* (the loss, friction's tangent included)
+    against the elastic bulk modulus K, with µ* at the rubber's own strain amplitude; None for
+    a design without ``bulk_modulus`` (nearly incompressible, K = 5000 µ: S as it is) or in a
+    direction of pure shear (:func:`core.shape.pure_shear`). ``bulk_modulus`` (Pa, may be an
+    array broadcast against µ_eq) replaces the design's."""
     bulk = design.material.bulk_modulus if bulk_modulus is None else bulk_modulus
     if bulk is None or pure_shear(design.mode, design.shape_kind):
         return None  # nothing to correct: K absent, or a direction that only shears the rubber
-    geometry, mode, kind = design.geometry, design.mode, design.shape_kind
-    return lambda mu: bulk_factor(geometry, mode, kind, mu / bulk)
+    return BulkCorrection(design.geometry, design.mode, design.shape_kind, bulk)
 
 
 def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | str = 1,
-                     route: Route = "analytic") -> np.ndarray:
+                     route: Route = "analytic", bulk_modulus: float | None = None) -> np.ndarray:
     """Complex stiffness at paired points (frequency_hz[i], amplitude[i]), broadcast together.
 
     For measured data, which is no grid: the same model and options as :func:`stiffness`
@@ -282,6 +290,9 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
         As for :func:`stiffness`.
     route : {'analytic', 'time-domain'}, default 'analytic'
         As for :func:`stiffness`.
+    bulk_modulus : float or None, default None
+        Replaces the design's bulk modulus, in Pa (:func:`bulk_correction`); ``math.inf`` gives
+        the incompressible limit, which no design file takes.
 
     Returns
     -------
@@ -322,7 +333,7 @@ def stiffness_points(design: Design, frequency_hz, amplitude, *, slices: int | s
         k = wave_stiffness(mode, geo.inner_radius, geo.outer_radius, geo.length,
                            modulus(f, design.strain(x)), f, effects["wave_effects"]["density"])
     elif slices == 1:
-        k = equivalent_stiffness(modulus, s, c, f, x, bulk_correction(design))
+        k = equivalent_stiffness(modulus, s, c, f, x, bulk_correction(design, bulk_modulus))
     else:
         nodes = continuum_nodes(geo, mode) if slices == "continuum" else slice_nodes(geo, mode, slices)
         fp, xp = (np.broadcast_to(v, shape).ravel() for v in (f, x))
@@ -407,10 +418,12 @@ def branch_stiffness(design: Design, frequency_hz, amplitude) -> dict[str, np.nd
     refuse_structural_effects(design, "the branch-by-branch stiffness")
     f = positive_values("frequency_hz", frequency_hz)[None, :]
     x = positive_values("amplitude", amplitude)[:, None]
-    s, eps = design.shape_factor, design.strain(x)
+    s, eps, bulk = design.shape_factor, design.strain(x), bulk_correction(design)
+    if bulk is not None:  # a compressible rubber: the branches at its own strain amplitude
+        eps, _ = bulk.rubber_modulus(modulus_function(design), f, eps)
     moduli = branch_moduli(design.material, design.effect_parameters, f, eps)
-    bulk = bulk_correction(design)  # a compressible rubber: the whole µ_eq's factor on each branch
-    factor = 1.0 if bulk is None else bulk(sum(moduli.values()))
+    # and the whole µ_eq's factor on each branch
+    factor = 1.0 if bulk is None else bulk.factor(sum(moduli.values()))
     return {name: s * modulus * factor for name, modulus in moduli.items()}  # eqs 17, 18 branch by branch
 
 
@@ -435,15 +448,6 @@ def material_model(design: Design) -> Design:
     if design.material.bulk_modulus is not None:
         design = design.replace(bulk_modulus=None)
     return design if len(kept) == len(design.effects) else design.replace(effects=kept)
-
-
-def refuse_compressible(design: Design, what: str) -> None:
-    """ValueError if ``design``'s bulk modulus changes its stiffness (radial, conical, a finite
-    axial bushing): ``what`` is computed for the material's branches alone, and the bulk spring
-    in series is none of them."""
-    if bulk_correction(design) is not None:
-        raise ValueError(f"material.bulk_modulus: {what} is computed from the material branches of an "
-                         f"incompressible rubber; leave bulk_modulus out for it (the stiffness honours it)")
 
 
 def refuse_structural_effects(design: Design, what: str, allowed=()) -> None:

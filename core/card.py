@@ -10,13 +10,14 @@ K_torsion / r_m², r_m = (a + b)/2 (the circumferential stiffness at the mean ra
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .bushing import factors, stiffness_points
 from .design import Design
 from .parameters import ROTATIONS, THESIS_MODES, TRANSLATIONS
 from .response import loss_factor
-from .shape import bulk_factor
 
 CARD_MODES = TRANSLATIONS + ROTATIONS  # axial, radial, torsion, conical
 
@@ -45,14 +46,14 @@ def card(design: Design, frequency_hz: float, displacement: float, angle: float)
 def against_incompressible(design: Design, frequency_hz: float, rows: list[dict]) -> dict[str, tuple[float, float]]:
     """How far each direction of the card (:func:`card`'s ``rows`` at ``frequency_hz``) lies
     from the same bushing of an incompressible rubber: the relative change of |K| and of the
-    loss factor, by mode. The limit is the series law at µ/K = 0 (:func:`core.shape.bulk_factor`,
-    a real factor on S·µ_eq); a design without ``bulk_modulus`` has K = 5000 µ."""
-    nearly = design.replace(bulk_modulus=None)
+    loss factor, by mode. The limit is the stiffness at µ/K = 0 (``bulk_modulus`` ∞ in
+    :func:`core.bushing.stiffness_points`: the series law's real factor on S·µ_eq, with µ_eq at
+    the whole drive's strain in the shear layer); a design without ``bulk_modulus`` has
+    K = 5000 µ."""
     out = {}
     for r in rows:
-        d = card_design(nearly, r["mode"])
-        k = complex(stiffness_points(d, frequency_hz, r["amplitude"])) * float(
-            bulk_factor(d.geometry, d.mode, d.shape_kind, 0.0))
+        d = card_design(design, r["mode"])
+        k = complex(stiffness_points(d, frequency_hz, r["amplitude"], bulk_modulus=math.inf))
         eta = float(loss_factor(np.array([k]))[0])
         out[r["mode"]] = (r["magnitude"] / abs(k) - 1.0, r["loss_factor"] / eta - 1.0)
     return out

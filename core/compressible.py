@@ -1,6 +1,7 @@
 """A compressible rubber as a shear layer in series with an elastic bulk spring (docs/model.md,
 "Compressibility"), for the outputs that follow the rubber's strain along a drive: the
-hysteresis loop (:mod:`core.loops`) and the time-domain element (:mod:`core.element`).
+hysteresis loop (:mod:`core.loops`) and the time-domain element (:mod:`core.element`); and the
+stiffness at the rubber's own strain amplitude (:class:`BulkCorrection`).
 
 The finite-length table's series law 1/S(x) = (1 + g(x − x₀))/S(x₀), x = µ/K,
 x₀ = 1/:data:`core.shape.BULK_RATIO`, gives the stiffness
@@ -23,11 +24,21 @@ at 250 and 0.33 % at 700; the best line over K/µ 50–10⁶ is still 2.2 % off 
 a bulk modulus is refused here (:data:`LONG_RADIAL_REFUSAL`) and keeps its closed form in the
 stiffness.
 
+The stiffness's first harmonic needs only the rubber's strain amplitude, and that follows from
+the energy balance for any closed form K = S·µ·φ(µ/K): the shear (deviatoric) energy is
+µ·∂K/∂µ·x̂²/2 at fixed drive (the strain field is stationary), so ε̂ = c·x̂·|√ψ(µ*/K)| with
+ψ(x) = d(xφ)/dx (:func:`core.shape.bulk_tangent`). For the table's series law this is the
+series' own ε̂ = c'x̂/|1 + C_b S'µ*|, c' the shear layer's strain factor (the force F = S'µ*x_r
+through both, x = x_r + C_b F), and K = S·µ*·φ(µ*/K) = S'µ*/(1 + C_b S'µ*); the long radial
+closed form gets its rubber's amplitude by the same rule (:meth:`BulkCorrection.rubber_modulus`
+solves it with µ* = µ_eq(f, ε̂)).
+
 :func:`steady_series_strain` solves one steady period of the series for a harmonic drive: the
 shear strain ε(θ) at every sample with ε + κσ[ε] = c x̂ sin θ, κ = C_b S/2 (1/Pa), σ[ε] the
 rubber's three branches (the fractional one over the whole period, harmonic by harmonic; Berg's
 friction on the steady symmetric loop between ±ε̂, ε̂ = max ε), by Newton's method with the
-linear systems solved by GMRES.
+linear systems solved by GMRES. :func:`series_history_strain` solves the same balance for any
+sampled drive history, ε + κσ[ε] = c x (the force history, :func:`core.loops.force_history`).
 """
 
 from __future__ import annotations
@@ -40,12 +51,21 @@ import numpy as np
 from .design import Design
 from .effects import branch_moduli
 from .material import ConvergenceError, elastic_stress, friction_modulus, friction_reversal_ratio
-from .shape import BULK_RATIO, pure_shear, strain_factor_from_shape, table
+from .shape import (
+    BULK_RATIO,
+    bulk_factor,
+    bulk_tangent,
+    pure_shear,
+    strain_factor_from_shape,
+    table,
+)
 
 LONG_RADIAL_REFUSAL = (
     "material.bulk_modulus: the long {mode} closed form of a compressible rubber (plane strain) has no "
     "series form (a shear layer in series with a bulk spring is up to 4.7 % off it at K/µ 50, 0.9 % at 250); "
     "{what} follows the rubber's strain through that series: use shape 'finite'")
+RUBBER_TOLERANCE = 1e-13  # on ln ε̂ of the rubber's strain amplitude (relative)
+MAX_RUBBER_ITERATIONS = 60
 SAMPLES = 2048  # at least this many samples a period inside the steady solve
 TOLERANCE = 1e-12  # relative to the drive's strain c·x̂, on the series balance
 MAX_NEWTON = 60
@@ -106,6 +126,94 @@ def bulk_series(design: Design, what: str = "the time-domain element") -> BulkSe
     g = table().slope(design.mode, b / a, L / (b - a))
     s = s0 / (1.0 - g / BULK_RATIO)
     return BulkSeries(s, strain_factor_from_shape(s, a, b, L), g / (s0 * bulk))
+
+
+# ---- the stiffness at the rubber's own strain amplitude ------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class BulkCorrection:
+    """How an elastic bulk modulus changes K = S·µ* of a design (:func:`core.bushing.bulk_correction`),
+    by the correspondence principle, at the rubber's own strain amplitude.
+
+    Attributes
+    ----------
+    geometry, mode, shape
+        The design's (:func:`core.shape.bulk_factor`'s arguments).
+    bulk_modulus : float or numpy.ndarray
+        K in Pa, broadcast against µ* (e.g. one value per sample shaped (n, 1, …)).
+    """
+
+    geometry: object
+    mode: str
+    shape: str
+    bulk_modulus: object
+
+    def factor(self, mu):
+        """S(µ*/K)/S (dimensionless) at the complex equivalent modulus µ* (Pa)."""
+        return bulk_factor(self.geometry, self.mode, self.shape, mu / self.bulk_modulus)
+
+    def strain_ratio(self, mu):
+        """ε̂/(c x̂) = |√ψ|, ψ = d(xφ)/dx at x = µ*/K (:func:`core.shape.bulk_tangent`): the
+        rubber's strain amplitude against the drive's c·x̂ (dimensionless)."""
+        return np.sqrt(np.abs(bulk_tangent(self.geometry, self.mode, self.shape, mu / self.bulk_modulus)))
+
+    def rubber_modulus(self, modulus, frequency_hz, strain):
+        """The rubber's strain amplitude ε̂ and µ*(f, ε̂) where ε̂ = ``strain``·|√ψ(µ*(f, ε̂)/K)|
+        (docs/model.md, "Compressibility"), ``strain`` = c·x̂ the drive's equivalent strain;
+        ``modulus`` is µ*(frequency_hz, strain_amplitude) in Pa, broadcast.
+
+        Solved for ln ε̂ at every point at once by the secant method, started from the fixed-point
+        step and kept inside the bracket the signs of the residual h = ln ε̂ − ln(c x̂) − ln|√ψ|
+        have shown (bisection where a step leaves it); a point stays where it is once
+        |h| ≤ :data:`RUBBER_TOLERANCE`, so a point's value does not depend on the others solved
+        with it. Where µ* does not depend on the amplitude the first step is the solution.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (ε̂, µ*): the strain amplitude (dimensionless) and the complex modulus in Pa, shaped as
+            the arguments broadcast together.
+
+        Raises
+        ------
+        ConvergenceError
+            If some point has not converged in :data:`MAX_RUBBER_ITERATIONS` steps.
+        """
+        drive = np.log(np.asarray(strain, dtype=float))
+
+        def residual(t):
+            mu = modulus(frequency_hz, np.exp(t))
+            return t - drive - np.log(self.strain_ratio(mu)), mu
+
+        h, mu = residual(drive)
+        shape = np.broadcast_shapes(np.shape(h), np.shape(mu))
+        t = np.array(np.broadcast_to(drive, shape))
+        h, mu = np.array(np.broadcast_to(h, shape)), np.array(np.broadcast_to(mu, shape))
+        lo, hi = np.full(shape, -np.inf), np.full(shape, np.inf)
+        t_old = h_old = None
+        for _ in range(MAX_RUBBER_ITERATIONS):
+            done = (np.abs(h) <= RUBBER_TOLERANCE) | ~np.isfinite(h)  # not finite: the caller says so
+            if done.all():
+                return np.exp(t), mu
+            lo, hi = np.where(h < 0, np.maximum(lo, t), lo), np.where(h > 0, np.minimum(hi, t), hi)
+            slope = np.ones(shape)
+            if t_old is not None:
+                moved = t != t_old
+                slope = np.divide(h - h_old, t - t_old, out=slope, where=moved)
+                slope = np.where(np.isfinite(slope) & (slope > 0), slope, 1.0)
+            step = t - h / slope
+            inside = (step > lo) & (step < hi)
+            both = np.isfinite(lo) & np.isfinite(hi)
+            step = np.where(inside, step, np.where(both, 0.5 * (lo + hi), np.where(np.isfinite(hi), hi - 1.0, lo + 1.0)))
+            t_new = np.where(done, t, step)
+            h_new, mu_new = residual(t_new)
+            t_old, h_old = t, h
+            t = t_new
+            h = np.where(done, h, np.broadcast_to(h_new, shape))
+            mu = np.where(done, mu, np.broadcast_to(mu_new, shape))
+        raise ConvergenceError(f"the rubber's strain amplitude through the bulk spring did not converge in "
+                               f"{MAX_RUBBER_ITERATIONS} steps (residual {float(np.nanmax(np.abs(h))):.2e})")
 
 
 # ---- one steady period of the series ------------------------------------------------------
@@ -217,3 +325,64 @@ def steady_series_strain(design: Design, series: BulkSeries, frequency_hz: float
                                "once a period")
     every = n // points
     return tuple(v[::every].copy() for v in (eps, el, ve, fr))
+
+
+# ---- any sampled history through the series ----------------------------------------------
+
+
+def series_history_strain(design: Design, series: BulkSeries, displacement, dt: float) -> np.ndarray:
+    """The rubber's shear strain at every sample of the drive history ``displacement`` (m or rad,
+    every ``dt`` s) through ``series``: ε + κσ[ε] = c x at once over the whole history, σ[ε] the
+    material's branches along it (:func:`core.material.branch_stresses`: the fractional memory
+    from rest, friction's reversals), by Newton's method with Krylov steps (finite differences of
+    σ[ε] along each direction, so friction's reversal memory is followed as it is), to
+    :data:`TOLERANCE` of the largest c|x|. Each residual is O(N log N); the steps are preconditioned
+    by the linear part at rest, 1 + κ(2µ + σ_fmax/ε½ + m D^α), the fractional derivative by its
+    Grünwald–Letnikov symbol in the frequency domain (the history padded to twice its length).
+
+    Returns
+    -------
+    numpy.ndarray
+        ε at each sample (dimensionless).
+
+    Raises
+    ------
+    ConvergenceError
+        If Newton's method does not meet the tolerance in :data:`MAX_NEWTON` iterations.
+    """
+    from scipy.optimize import NoConvergence, newton_krylov
+    from scipy.sparse.linalg import LinearOperator
+
+    from .material import branch_stresses
+
+    m = design.material
+    effects = design.effect_parameters
+    target = series.strain_factor * np.asarray(displacement, dtype=float)
+    scale = float(np.max(np.abs(target)))
+    if scale == 0.0:
+        return np.zeros_like(target)
+    kappa = series.kappa
+
+    def residual(eps):
+        br = branch_stresses(m, eps, dt, effects)
+        return eps + kappa * (br.elastic + br.fractional + br.friction) - target
+
+    # the linear part at rest, 1 + κ(2µ + σ_fmax/ε½ + m D^α), in the frequency domain: the
+    # Grünwald–Letnikov symbol dt^(−α)(1 − e^(−iω dt))^α on a grid padded to 2N (no wrap-around)
+    n = target.size
+    size = 2 * n
+    z = np.exp(-2j * np.pi * np.arange(size // 2 + 1) / size)
+    symbol = 1.0 + kappa * (2.0 * m.shear_modulus + m.friction_stress_max / m.friction_strain_half
+                            + m.fractional_coefficient * dt ** -m.fractional_order * (1.0 - z) ** m.fractional_order)
+
+    def precondition(v):
+        return np.fft.irfft(np.fft.rfft(v, size) / symbol, size)[:n]
+
+    start = precondition(target)
+    try:
+        return newton_krylov(residual, start, f_tol=TOLERANCE * scale, maxiter=MAX_NEWTON,
+                             inner_M=LinearOperator((n, n), precondition), inner_inner_m=5)
+    except NoConvergence as exc:
+        worst = float(np.max(np.abs(residual(np.asarray(exc.args[0]))))) if exc.args else float("nan")
+        raise ConvergenceError(f"the force history through the bulk spring did not converge in {MAX_NEWTON} Newton "
+                               f"iterations (residual {worst / scale:.2e} of the drive's largest strain)") from None

@@ -24,7 +24,7 @@ from .bushing import (
     positive_values,
     refuse_structural_effects,
 )
-from .compressible import bulk_series, in_series, steady_series_strain
+from .compressible import bulk_series, in_series, series_history_strain, steady_series_strain
 from .design import Design
 from .effects import branch_moduli
 from .parameters import MODE
@@ -227,6 +227,27 @@ def loop_force(design: Design, frequency_hz: float, amplitude: float, phase):
 
 
 
+SERIES_SAMPLES = 2048  # the phases of the series' steady period a measured loop's phases are read from
+
+
+def steady_loop_force(design: Design, frequency_hz: float, amplitude: float, phase):
+    """Steady force (moment) branches at any drive phases θ, x = x̂ sin θ, of the model a
+    measured loop is compared with: (elastic, viscoelastic, friction), each in N or N·m.
+    :func:`loop_force` in closed form; where a bulk modulus acts as a spring in series
+    (:func:`core.compressible.bulk_series`), the series' steady period
+    (:func:`core.compressible.steady_series_strain`) on :data:`SERIES_SAMPLES` phases, read at
+    ``phase`` by periodic linear interpolation (within about 10⁻⁶ of the force's range).
+    ValueError for the long radial closed form with a bulk modulus (no series form)."""
+    series = bulk_series(design, "the loop's force at measured phases")
+    if series is None:
+        return loop_force(design, frequency_hz, amplitude, phase)
+    _, *stresses = steady_series_strain(design, series, frequency_hz, amplitude, SERIES_SAMPLES)
+    scale = series.shape_factor / (2.0 * series.strain_factor)
+    grid = 2.0 * np.pi * np.arange(SERIES_SAMPLES) / SERIES_SAMPLES
+    theta = np.mod(np.asarray(phase, dtype=float), 2.0 * np.pi)
+    return tuple(scale * np.interp(theta, grid, part, period=2.0 * np.pi) for part in stresses)
+
+
 def _time_domain_loop(material, effects, frequency_hz, eps_amp, points):
     """Last period of the simulated stresses, on the loop's phase grid θ = 2πk/points."""
     td = mat.equivalent_modulus_time_domain(material, frequency_hz, eps_amp, effects=effects)
@@ -288,7 +309,10 @@ def force_history(design: Design, displacement, dt: float) -> HistoryResult:
 
     For a history sampled every ``dt`` seconds, e.g. from a multibody simulation. O(N log N):
     the fractional memory is an FFT convolution (eq 3), the friction state changes only at
-    reversals (eq 6).
+    reversals (eq 6). A bulk modulus that squeezes the rubber (radial, conical, a finite axial
+    bushing) is a bulk spring in series (:mod:`core.compressible`): the rubber's strain along the
+    whole history solves ε + κσ[ε] = c x (:func:`core.compressible.series_history_strain`, a few
+    Newton steps of such residuals), and F = S σ/(2c) of the series' shear layer.
 
     Parameters
     ----------
@@ -312,8 +336,11 @@ def force_history(design: Design, displacement, dt: float) -> HistoryResult:
     ValueError
         If ``displacement`` is not a one-dimensional array of finite numbers, ``dt`` is not a
         positive finite number, the design has a refused effect, or it has
-        ``rate_amplitude_coupling``, or a bulk modulus that squeezes the rubber (the series
-        with the bulk spring is solved step by step by :mod:`core.element`).
+        ``rate_amplitude_coupling``, or a bulk modulus in the long radial direction (no series
+        form).
+    ConvergenceError
+        If the series with a bulk spring (:func:`core.compressible.series_history_strain`) does
+        not converge.
 
     Notes
     -----
@@ -326,14 +353,13 @@ def force_history(design: Design, displacement, dt: float) -> HistoryResult:
     if not (np.isfinite(dt) and dt > 0):
         raise ValueError(f"dt: must be a positive finite number, got {dt!r}")
     refuse_structural_effects(design, "the force history", allowed=("inertia",))
-    if bulk_series(design, "the force history") is not None:
-        raise ValueError("material.bulk_modulus: the force history follows the rubber's branches along the drive, and a "
-                         "bulk spring in series moves the rubber's strain off c·x at every sample (an implicit solve "
-                         "a step): the time-domain element (core.element, `bushing fmu`) solves that series step by "
-                         "step; the steady loop (core.loops.loop) honours it too")
     effects = design.effect_parameters
-    scale = force_per_stress(design)
-    br = mat.branch_stresses(design.material, design.strain(x), dt, effects)
+    series = bulk_series(design, "the force history")
+    if series is None:
+        scale, strain = force_per_stress(design), design.strain(x)
+    else:  # the rubber's strain through the bulk spring in series, the whole history at once
+        scale, strain = series.shape_factor / (2.0 * series.strain_factor), series_history_strain(design, series, x, dt)
+    br = mat.branch_stresses(design.material, strain, dt, effects)
     inertial = np.zeros_like(x)
     if "inertia" in effects:  # from rest at zero: x_{-1} = x_{-2} = 0
         padded = np.concatenate(([0.0, 0.0], x))

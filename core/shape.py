@@ -331,6 +331,30 @@ def bulk_factor(geometry: Geometry, mode: str, shape: str | None, x):
     return table().compressible_factor(mode, b / a, L / (b - a), np.asarray(x))
 
 
+def bulk_tangent(geometry: Geometry, mode: str, shape: str | None, x):
+    """d(x·φ(x))/dx with φ = :func:`bulk_factor`: (1/S)·∂(µ·S(µ/K))/∂µ at fixed K, the
+    stiffness' derivative in the shear modulus, by which the shear (deviatoric) part of the
+    strain energy is µ·∂K/∂µ·x̂²/2 (dimensionless; ``x`` = µ/K, real or complex, broadcast).
+
+    The finite-length table's series law: (1 − g x₀)/(1 + g(x − x₀))²; the long radial closed
+    form: its derivative in x; 1 for pure shear."""
+    a, b, L = _radii(geometry.inner_radius, geometry.outer_radius, geometry.length)
+    kind = shape or checked_mode(mode).default_shape
+    x = np.asarray(x)
+    if pure_shear(mode, kind):
+        return np.ones_like(x * 1.0)
+    if kind == "long":  # radial: S + x dS/dx of the plane-strain solution
+        nu = (3.0 - 2.0 * x) / (2.0 * (3.0 + x))
+        dnu = -4.5 / (3.0 + x) ** 2
+        k, ln, r = 3.0 - 4.0 * nu, math.log(b / a), (b * b - a * a) / (b * b + a * a)
+        den = k * ln - r / k
+        dden = -4.0 * dnu * (ln + r / k**2)
+        s, ds = (1.0 - nu) / den, (-dnu * den - (1.0 - nu) * dden) / den**2
+        return 8.0 * math.pi * L * (s + x * ds) / long_shape_factor(a, b, L, "radial")
+    g = table().slope(mode, b / a, L / (b - a))
+    return (1.0 - g / BULK_RATIO) / (1.0 + g * (x - 1.0 / BULK_RATIO)) ** 2
+
+
 def strain_factor(geometry: Geometry, mode: str, shape: str | None = None) -> float:
     """The strain factor c of a bushing in ``mode``, with ε_eq = c·x̂.
 

@@ -14,7 +14,7 @@ import numpy as np
 from .bushing import stiffness_points
 from .data import MeasuredLoop, MeasuredStiffness
 from .design import PAPER_B, TABLE_1, Design
-from .loops import loop_force
+from .loops import steady_loop_force
 
 
 def synthetic_stiffness(design: Design, frequency_hz, amplitude, *, noise: float = 0.005,
@@ -34,7 +34,7 @@ def synthetic_loop(design: Design, frequency_hz: float, amplitude: float, *, per
     rng = np.random.default_rng(seed)
     t = np.arange(periods * per_period) / (per_period * frequency_hz)
     theta = 2 * np.pi * frequency_hz * t + phase
-    force = sum(loop_force(design, frequency_hz, amplitude, theta))
+    force = sum(steady_loop_force(design, frequency_hz, amplitude, theta))
     force = force + noise * np.max(np.abs(force)) * rng.standard_normal(t.size)
     return MeasuredLoop(t, amplitude * np.sin(theta), force)
 

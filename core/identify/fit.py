@@ -31,10 +31,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..bushing import check_measured_amplitude, refuse_compressible, stiffness_points
+from ..bushing import check_measured_amplitude, stiffness_points
+from ..compressible import bulk_series
 from ..data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from ..design import Design
-from ..loops import loop_force
+from ..loops import steady_loop_force
 from ..parameters import BRANCH_PARAMETERS, MATERIAL
 from ..parts import as_dict
 from ..points import PointsModel
@@ -218,7 +219,7 @@ class _Problem:
             r = relative_residual(k, self.data.stiffness) * self.data.weight
             parts += [r.real, r.imag]
         if self.loop is not None:
-            f = sum(loop_force(design, self.loop_f, self.loop_amp, self.loop_phase))
+            f = sum(steady_loop_force(design, self.loop_f, self.loop_amp, self.loop_phase))
             parts.append(self.loop_weight * (f - self.loop_force) / self.loop_scale)
         return _evaluable(np.concatenate(parts))
 
@@ -354,7 +355,7 @@ def _result(problem: _Problem, sol, method: str, starts: int, design: Design, in
         g, by_mode = gap(k, data.stiffness, data.count), gaps_by_mode(k, data)
     loop_rms = None
     if loop is not None:
-        f = sum(loop_force(fitted, problem.loop_f, problem.loop_amp, loop.harmonic()[2]))
+        f = sum(steady_loop_force(fitted, problem.loop_f, problem.loop_amp, loop.harmonic()[2]))
         measured = loop.force - np.mean(loop.force)
         # docs/files.md: relative to the loop's peak force (the fit weighs it by its RMS instead)
         loop_rms = float(np.sqrt(np.mean((f - measured) ** 2)) / np.max(np.abs(measured)))
@@ -385,7 +386,7 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     if data is not None:
         check_data_amplitudes(design, data)  # the measured amplitudes, for this bushing
     if loop is not None:
-        refuse_compressible(design, "a fit to a measured loop")
+        bulk_series(design, "a fit to a measured loop")  # the long radial closed form with K: refused by name
         check_measured_amplitude(design, loop.harmonic()[1], "the loop's amplitude")
         loop.check_force()  # after the amplitude: a displacement in wrong units is named as such
     n = (0 if data is None else 2 * len(data)) + (0 if loop is None else loop.force.size)
