@@ -10,6 +10,7 @@
 #define NEWTON_TOLERANCE 1e-13 /* its relative steps in the load and the strains */
 #define LAYER_TOLERANCE 2e-15  /* nested solve: relative step in a layer's strain, a few ulp */
 #define LOAD_TOLERANCE 1e-14   /* nested solve: relative step in the channel's load */
+#define ROUNDING 8.0 * 2.220446049250313e-16 /* a residual's rounding: 8 ulp of its terms' size */
 
 /* ------------------------------------------------------------------------------------------ */
 /* one layer's law over a step */
@@ -23,6 +24,15 @@ static inline double stress(const bs_law *law, const bs_layer *l, double eps, in
     *slope = law->two_mu * (1.0 + 3.0 * law->beta * e2) + law->b + q * l->d0[up] * w;
     return law->two_mu * eps * (1.0 + law->beta * e2) + l->z + law->b * (eps - l->eps_c)
            + l->sr[up] + u * q;
+}
+
+/* the size of the terms of stress(): its rounding error is a few ulp of this, whatever the
+ * residual's own size (a stress target far below the memory's or the friction's stress) */
+static inline double stress_size(const bs_law *law, const bs_layer *l, double eps, int up)
+{
+    double u = eps - l->er[up], w = 1.0 / (l->d0[up] + (up ? u : -u));
+    return fabs(law->two_mu * eps * (1.0 + law->beta * eps * eps)) + fabs(l->z)
+           + fabs(law->b * (eps - l->eps_c)) + fabs(l->sr[up]) + fabs(u * l->num[up] * w);
 }
 
 /* the layer's stress at its committed strain (both branches meet there) */
@@ -271,6 +281,9 @@ static int layer_strain(const bs_law *law, bs_layer *l, double target, long *cou
         if (r < 0.0) lo = eps; else hi = eps;
         double step = -r / slope;
         double tol = LAYER_TOLERANCE * bs_larger(fabs(eps), fabs(eps - eps_c));
+        /* a residual within its own rounding (terms far larger than the target's: a tiny
+         * strain after a long step) moves the strain by no more than that rounding's share */
+        if (fabs(r) <= ROUNDING * (stress_size(law, l, eps, up) + fabs(target))) tol = bs_larger(tol, fabs(step));
         if (fabs(step) <= tol) {
             eps += step;
             break;
