@@ -3,6 +3,8 @@ data that changed, no WebGL, a PNG name per plot, the patched Panel and Bokeh in
 session's memory kept flat, and hostile values from the page."""
 
 
+import math
+
 import numpy as np
 import pytest
 
@@ -304,3 +306,46 @@ def test_a_change_of_numbers_shows_what_holoviews_draws_for_the_same_frames():
     live.show(pinned)
     assert asked == [1]  # a new shape: HoloViews builds it
     assert _same_numbers(_shown_numbers(live), _shown_numbers(drawn(pinned)))
+
+
+def _same(a, b) -> bool:
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True  # NaN, Bokeh's default of some numbers
+    return type(a) is type(b) and a == b
+
+
+def test_the_cached_property_defaults_are_bokehs_own(app):
+    """app.patches.cache_immutable_defaults keeps Bokeh's property defaults per (property, class):
+    for every property of every Bokeh and Panel model class, read through the cache (twice: the
+    second read is the cached one) and through Bokeh's own ``themed_default``, the same immutable
+    value; and any other default (a list, a dict, a model) a new one at each read, as Bokeh makes it."""
+    import inspect
+
+    from bokeh.core.has_props import HasProps
+    from bokeh.core.property.bases import Property
+
+    from app import patches
+
+    patches.install()
+    ours = Property.themed_default
+    assert ours.cached_by_bushing
+    assert list(inspect.signature(ours.original).parameters) == ["self", "cls", "name", "theme_overrides", "no_eval"]
+    classes, seen, containers = [HasProps], set(), 0
+    while classes:
+        cls = classes.pop()
+        classes.extend(c for c in cls.__subclasses__() if c not in seen)
+        seen.add(cls)
+    checked = 0
+    for cls in seen:
+        for name in cls.properties():
+            prop = cls.lookup(name).property
+            bokeh = ours.original(prop, cls, name, None)
+            if patches._immutable(bokeh):
+                for _ in range(2):
+                    cached = ours(prop, cls, name, None)
+                    assert _same(cached, bokeh), (cls, name, cached, bokeh)
+                    checked += 1
+            elif isinstance(bokeh, (list, dict, HasProps)):  # Bokeh's own: a new one at each read
+                containers += 1
+                assert ours(prop, cls, name, None) is not ours(prop, cls, name, None), (cls, name)
+    assert len(seen) > 300 and checked > 10_000 and containers > 100, (len(seen), checked, containers)
