@@ -29,9 +29,11 @@ page instead of queueing on the server's one thread.
 property's default at every read of a property never set: the class's overridden defaults
 merged over its whole MRO, then the value validated (``Property.themed_default``), tens of
 thousands of times per page built and serialised. Where the default is an immutable value and
-no theme overrides it, the result is the same every time; it is kept per (property, class).
-Measured in process (8 page builds, median): 744–751 ms of CPU per page without, 684–685 ms
-with. A test compares it with Bokeh's own result for every property of every model class.
+no theme overrides it, the result is the same every time; it is kept per (property, class), and
+so is whether a property's default is unstable (asked at every such read, with two imports).
+Measured in process (8 page builds and serialisations, median, back to back): 744–782 ms of CPU
+per page without, 633–650 ms with. A test compares both with Bokeh's own answers for every
+property of every model class.
 
 **BokehJS paint** (:data:`BOKEHJS_PAINT_PATCHES`, run in the page when its document is
 ready). Three costs BokehJS 3.9 pays on every paint: a plot component's stylesheet rewritten with
@@ -113,6 +115,7 @@ from pathlib import Path
 
 import numpy as np
 from bokeh.core.property.bases import Property
+from bokeh.core.property.descriptors import PropertyDescriptor
 from panel.io import resources as panel_resources
 from panel.io.document import hold as panel_hold
 from panel.io.server import DocHandler, WSHandler
@@ -180,7 +183,9 @@ def cache_immutable_defaults() -> None:
     """Bokeh's ``Property.themed_default`` looked up once per (property, class) where the default
     is an immutable value (None, a number, a string, a tuple of them) and no theme overrides it,
     instead of at every read of a property never set (see the module). Other defaults (lists,
-    dicts, models, callables: a new one each time) and themed ones go to Bokeh's own code."""
+    dicts, models, callables: a new one each time) and themed ones go to Bokeh's own code. And
+    whether a property's default is unstable (``PropertyDescriptor.has_unstable_default``, which
+    depends on the property and the class's overridden defaults only), once per pair."""
     original = Property.themed_default
     if getattr(original, "cached_by_bushing", False):
         return
@@ -200,6 +205,18 @@ def cache_immutable_defaults() -> None:
     themed_default.cached_by_bushing = True
     themed_default.original = original
     Property.themed_default = themed_default
+
+    original_unstable = PropertyDescriptor.has_unstable_default
+    unstable: dict = {}
+
+    def has_unstable_default(self, obj):  # the property's and the class's: one answer per pair
+        key = (id(self), type(obj))
+        if key not in unstable:
+            unstable[key] = original_unstable(self, obj)
+        return unstable[key]
+
+    has_unstable_default.original = original_unstable
+    PropertyDescriptor.has_unstable_default = has_unstable_default
 
 
 def local_stylesheets(doc) -> None:

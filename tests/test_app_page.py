@@ -323,6 +323,7 @@ def test_the_cached_property_defaults_are_bokehs_own(app):
 
     from bokeh.core.has_props import HasProps
     from bokeh.core.property.bases import Property
+    from bokeh.core.property.descriptors import PropertyDescriptor
 
     from app import patches
 
@@ -348,4 +349,8 @@ def test_the_cached_property_defaults_are_bokehs_own(app):
             elif isinstance(bokeh, (list, dict, HasProps)):  # Bokeh's own: a new one at each read
                 containers += 1
                 assert ours(prop, cls, name, None) is not ours(prop, cls, name, None), (cls, name)
+            descriptor, bare = cls.lookup(name), object.__new__(cls)  # an instance's class is all it reads
+            if isinstance(descriptor, PropertyDescriptor):  # not an alias of another property
+                ask = descriptor.has_unstable_default
+                assert ask(bare) is ask(bare) is ask.original(descriptor, bare), (cls, name)
     assert len(seen) > 300 and checked > 10_000 and containers > 100, (len(seen), checked, containers)
