@@ -11,7 +11,6 @@ with :func:`shape_phrase`.
 from __future__ import annotations
 
 from core import Design
-from core.compressible import in_series
 from core.numbers import format_value
 from core.parameters import BY_NAME, MODE, THESIS_MODES
 from core.shape import pure_shear
@@ -46,9 +45,9 @@ def shape_phrase(design: Design, modes: tuple[str, ...] | None = None) -> str:
         k = design.material.bulk_modulus
         bulk = "" if k is None or pure_shear(design.mode, design.shape_kind) else (
             f" Bulk modulus K = {format_value(BY_NAME['bulk_modulus'].unit.to_display(k), 'GPa', 'parameter')}: "
-            + ("|K|, the loss factor and the loop include it (a bulk spring in series); the branches are the "
-               "material's (incompressible)." if in_series(design) else
-               "|K| and the loss factor include it; the loop and the branches are the material's (incompressible)."))
+            + "|K|, the loss factor and the loop include it (a bulk spring in series"
+            + (", matched to the plane-strain closed form at this frequency and amplitude" if design.shape_kind == "long"
+               else "") + "); the branches are the material's (incompressible).")
         return f"Shape factor: {shape_used(design)}.{bulk}"
     long = [m for m in modes if shape_used(design, m) != "finite-length table"]
     finite = [m for m in modes if m not in long]

@@ -15,14 +15,19 @@ complex, amplitude-dependent µ* of the rubber: the force is the same through bo
 the sum of their displacements, x = ε/c + C_b F, so the rubber's own strain is not c·x.
 
 The long radial bushing's plane-strain closed form (:func:`core.shape.long_radial_compressible`)
-has no such form: its stiffness of a thin wall tends to πaL(K + 7µ/3)/t, the bulk and the shear
-moduli side by side, not in series. The series law through its tangent at x = 0,
+has no such global form: its stiffness of a thin wall tends to πaL(K + 7µ/3)/t, the bulk and the
+shear moduli side by side, not in series. The series law through its tangent at x = 0,
 1/S(x) = (1 + g x)/S(0) with g = (ln q + 3r)/(ln q − r), q = b/a, r = (q² − 1)/(q² + 1)
 (:func:`long_radial_slope`), is off the closed form by up to 4.7 % at K/µ 50 (b/a → 1), 0.93 %
-at 250 and 0.33 % at 700; the best line over K/µ 50–10⁶ is still 2.2 % off (3.3 % for a complex
-µ*). That is more than the 0.3 % the finite table's law holds, so the long radial direction with
-a bulk modulus is refused here (:data:`LONG_RADIAL_REFUSAL`) and keeps its closed form in the
-stiffness.
+at 250 and 0.33 % at 700. So the long radial direction gets a series matched at its operating
+point instead (:func:`long_radial_series`): three real numbers (S', c', C_b) chosen so that at the
+complex µ* of that point the series' stiffness S'µ*/(1 + C_b S'µ*) is the closed form's
+S₀µ*φ(µ*/K) and the rubber's strain c'x̂/|1 + C_b S'µ*| is the energy rule's c·x̂·|√ψ(µ*/K)|
+(both are rational in x, so they take a complex µ*/K); as the loss vanishes the pair tends to the
+closed form's tangent at x. The loop and a fit to a measured loop match it at their own (f, x̂)
+(:func:`series_at`, the stiffness's µ*), the force history at its peak drive and dominant
+frequency (:func:`history_point`), the element at :data:`REFERENCE_FREQUENCY` and
+:data:`REFERENCE_STRAIN`.
 
 The stiffness's first harmonic needs only the rubber's strain amplitude, and that follows from
 the energy balance for any closed form K = S·µ·φ(µ/K): the shear (deviatoric) energy is
@@ -62,8 +67,12 @@ from .shape import (
 
 LONG_RADIAL_REFUSAL = (
     "material.bulk_modulus: the long {mode} closed form of a compressible rubber (plane strain) has no "
-    "series form (a shear layer in series with a bulk spring is up to 4.7 % off it at K/µ 50, 0.9 % at 250); "
-    "{what} follows the rubber's strain through that series: use shape 'finite'")
+    "global series form (a shear layer in series with a bulk spring is up to 4.7 % off it at K/µ 50, 0.9 % at 250): "
+    "{what} needs the operating point (frequency and amplitude) its series is matched at")
+# the element's operating point for the long radial closed form with a bulk modulus (docs/element.md)
+REFERENCE_FREQUENCY = 10.0  # Hz
+REFERENCE_STRAIN = 1e-3  # the drive's equivalent strain c·x̂
+LOSS_FLOOR = 1e-6  # |Im µ*|/|µ*| below which the matched pair is the closed form's tangent
 RUBBER_TOLERANCE = 1e-13  # on ln ε̂ of the rubber's strain amplitude (relative)
 MAX_RUBBER_ITERATIONS = 60
 SAMPLES = 2048  # at least this many samples a period inside the steady solve
@@ -105,16 +114,17 @@ def long_radial_slope(radius_ratio: float) -> float:
 
 
 def in_series(design: Design) -> bool:
-    """Whether ``design``'s bulk modulus acts as a spring in series (:func:`bulk_series`): K is
-    given, the direction squeezes the rubber, and its shape factor is the finite-length table's."""
-    return (design.material.bulk_modulus is not None and not pure_shear(design.mode, design.shape_kind)
-            and design.shape_kind == "finite")
+    """Whether ``design``'s bulk modulus acts as a spring in series (:func:`series_at`): K is given
+    and the direction squeezes the rubber (the finite-length table's directions and the long
+    radial closed form, whose series is matched at an operating point)."""
+    return design.material.bulk_modulus is not None and not pure_shear(design.mode, design.shape_kind)
 
 
 def bulk_series(design: Design, what: str = "the time-domain element") -> BulkSeries | None:
     """The series form of ``design`` in its own mode, or None where the bulk modulus is absent
     or does not act (pure shear: torsion, the long axial bushing). ValueError for the long
-    radial closed form (:data:`LONG_RADIAL_REFUSAL`, naming ``what``)."""
+    radial closed form (:data:`LONG_RADIAL_REFUSAL`, naming ``what``): its series depends on the
+    operating point (:func:`series_at`)."""
     bulk = design.material.bulk_modulus
     if bulk is None or pure_shear(design.mode, design.shape_kind):
         return None
@@ -126,6 +136,54 @@ def bulk_series(design: Design, what: str = "the time-domain element") -> BulkSe
     g = table().slope(design.mode, b / a, L / (b - a))
     s = s0 / (1.0 - g / BULK_RATIO)
     return BulkSeries(s, strain_factor_from_shape(s, a, b, L), g / (s0 * bulk))
+
+
+def long_radial_series(design: Design, modulus: complex) -> BulkSeries:
+    """The series matched to the long radial closed form at the rubber's complex modulus
+    ``modulus`` µ* (Pa) (see the module's docstring): with A = 1/(S₀µ*φ(µ*/K)) the closed form's
+    compliance, C_b = Im(µ*A)/Im(µ*), S' = 1/Re(µ*(A − C_b)) (so that µ*(A − C_b) is real and
+    1/(S'µ*) + C_b = A), and c' = S'·c·|√ψ(µ*/K)|·|µ*A| (so that the series' rubber strain
+    c'x̂/|1 + C_b S'µ*| = c'x̂/(S'|µ*A|) is the energy rule's c·x̂·|√ψ|). Where |Im µ*| < :data:`LOSS_FLOOR`·|µ*|, the
+    closed form's tangent at the real µ: S' = S₀φ²/ψ, C_b = (φ − ψ)/(S₀φ²µ), its limit."""
+    mu = complex(modulus)
+    x = mu / design.material.bulk_modulus
+    geo = design.geometry
+    s0, c = design.shape_factor, design.strain_factor
+    phi = complex(bulk_factor(geo, design.mode, "long", x))
+    psi = complex(bulk_tangent(geo, design.mode, "long", x))
+    a = 1.0 / (s0 * mu * phi)
+    if abs(mu.imag) >= LOSS_FLOOR * abs(mu):
+        compliance = (mu * a).imag / mu.imag
+    else:
+        compliance = ((phi - psi) / (s0 * phi * phi * mu)).real
+    s = 1.0 / (mu * (a - compliance)).real
+    return BulkSeries(s, s * c * math.sqrt(abs(psi)) * abs(mu * a), compliance)
+
+
+def series_at(design: Design, modulus, frequency_hz: float, amplitude: float,
+              what: str = "the hysteresis loop") -> BulkSeries | None:
+    """The series (:class:`BulkSeries`) ``design`` follows at the drive frequency (Hz) and
+    amplitude x̂ (m or rad): :func:`bulk_series` where that is the table's, and for the long radial
+    closed form :func:`long_radial_series` at the µ* the stiffness takes there (µ*(f, ε̂) at the
+    rubber's own strain amplitude, :meth:`BulkCorrection.rubber_modulus`); None where the bulk
+    modulus is absent or does not act. ``modulus`` is µ_eq(f, ε̂) in Pa
+    (:func:`core.bushing.modulus_function`)."""
+    if not in_series(design) or design.shape_kind != "long":
+        return bulk_series(design, what)
+    bulk = BulkCorrection(design.geometry, design.mode, design.shape_kind, design.material.bulk_modulus)
+    _, mu = bulk.rubber_modulus(modulus, frequency_hz, design.strain(amplitude))
+    return long_radial_series(design, complex(np.asarray(mu).ravel()[0]))
+
+
+def history_point(displacement, dt: float) -> tuple[float, float]:
+    """The operating point a sampled drive history's long radial series is matched at
+    (:func:`series_at`): its dominant frequency, that of the largest bin of its discrete Fourier
+    transform past zero (Hz; 1/(2 dt) for a single sample), and its peak |x| (m or rad). For a
+    whole number of periods of a harmonic drive, its frequency and amplitude."""
+    x = np.asarray(displacement, dtype=float)
+    spectrum = np.abs(np.fft.rfft(x))[1:]
+    frequency = (int(np.argmax(spectrum)) + 1) / (x.size * dt) if spectrum.size else 0.5 / dt
+    return frequency, float(np.max(np.abs(x)))
 
 
 # ---- the stiffness at the rubber's own strain amplitude ------------------------------------

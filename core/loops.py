@@ -21,10 +21,17 @@ from .bushing import (
     Route,
     check_strain,
     material_model,
+    modulus_function,
     positive_values,
     refuse_structural_effects,
 )
-from .compressible import bulk_series, in_series, series_history_strain, steady_series_strain
+from .compressible import (
+    history_point,
+    in_series,
+    series_at,
+    series_history_strain,
+    steady_series_strain,
+)
 from .design import Design
 from .effects import branch_moduli
 from .parameters import MODE
@@ -143,7 +150,8 @@ def loop(
     period (the same convergence rule as the time-domain modulus). The force is F = S·σ / (2c)
     of the material's stresses (:func:`force_per_stress`, eqs 14–18). A design whose bulk
     modulus squeezes the rubber (radial, conical, finite axial) is a shear layer in series with
-    a bulk spring (:func:`core.compressible.bulk_series`): the steady period of that series
+    a bulk spring (:func:`core.compressible.series_at`; the long radial closed form's matched at
+    this frequency and amplitude): the steady period of that series
     (:func:`core.compressible.steady_series_strain`), the branches at the rubber's own strain,
     by the analytic route only.
 
@@ -172,8 +180,7 @@ def loop(
     ValueError
         If the frequency or amplitude is not positive, the amplitude is beyond the equivalent
         strain :data:`core.bushing.MAX_STRAIN`, ``points`` or ``route`` is not allowed (the
-        time-domain route with a bulk spring), the design has a stiffness-level effect, or a
-        bulk modulus in the long radial direction (no series form).
+        time-domain route with a bulk spring), or the design has a stiffness-level effect.
     ConvergenceError
         If the time-domain route or the series solve does not reach its steady state.
     """
@@ -184,7 +191,7 @@ def loop(
         raise ValueError(f"points: must be a whole number ≥ 4, got {points!r}")
     refuse_structural_effects(design, "the branch-by-branch hysteresis loop")
     theta = 2.0 * np.pi * np.arange(points) / points
-    series = bulk_series(design, "the hysteresis loop")
+    series = series_at(design, modulus_function(design), f, xa, "the hysteresis loop")
     if series is not None:
         if route != "analytic":
             raise ValueError(f"route: the loop through a bulk spring in series is solved in its steady state "
@@ -234,11 +241,10 @@ def steady_loop_force(design: Design, frequency_hz: float, amplitude: float, pha
     """Steady force (moment) branches at any drive phases θ, x = x̂ sin θ, of the model a
     measured loop is compared with: (elastic, viscoelastic, friction), each in N or N·m.
     :func:`loop_force` in closed form; where a bulk modulus acts as a spring in series
-    (:func:`core.compressible.bulk_series`), the series' steady period
+    (:func:`core.compressible.series_at`, as :func:`loop`), the series' steady period
     (:func:`core.compressible.steady_series_strain`) on :data:`SERIES_SAMPLES` phases, read at
-    ``phase`` by periodic linear interpolation (within about 10⁻⁶ of the force's range).
-    ValueError for the long radial closed form with a bulk modulus (no series form)."""
-    series = bulk_series(design, "the loop's force at measured phases")
+    ``phase`` by periodic linear interpolation (within about 10⁻⁶ of the force's range)."""
+    series = series_at(design, modulus_function(design), frequency_hz, amplitude, "the loop's force at measured phases")
     if series is None:
         return loop_force(design, frequency_hz, amplitude, phase)
     _, *stresses = steady_series_strain(design, series, frequency_hz, amplitude, SERIES_SAMPLES)
@@ -312,7 +318,9 @@ def force_history(design: Design, displacement, dt: float) -> HistoryResult:
     reversals (eq 6). A bulk modulus that squeezes the rubber (radial, conical, a finite axial
     bushing) is a bulk spring in series (:mod:`core.compressible`): the rubber's strain along the
     whole history solves ε + κσ[ε] = c x (:func:`core.compressible.series_history_strain`, a few
-    Newton steps of such residuals), and F = S σ/(2c) of the series' shear layer.
+    Newton steps of such residuals), and F = S σ/(2c) of the series' shear layer; the long radial
+    closed form's series is matched at the history's dominant frequency and peak drive
+    (:func:`core.compressible.history_point`).
 
     Parameters
     ----------
@@ -336,8 +344,7 @@ def force_history(design: Design, displacement, dt: float) -> HistoryResult:
     ValueError
         If ``displacement`` is not a one-dimensional array of finite numbers, ``dt`` is not a
         positive finite number, the design has a refused effect, or it has
-        ``rate_amplitude_coupling``, or a bulk modulus in the long radial direction (no series
-        form).
+        ``rate_amplitude_coupling``.
     ConvergenceError
         If the series with a bulk spring (:func:`core.compressible.series_history_strain`) does
         not converge.
@@ -354,7 +361,9 @@ def force_history(design: Design, displacement, dt: float) -> HistoryResult:
         raise ValueError(f"dt: must be a positive finite number, got {dt!r}")
     refuse_structural_effects(design, "the force history", allowed=("inertia",))
     effects = design.effect_parameters
-    series = bulk_series(design, "the force history")
+    series = None
+    if in_series(design) and np.any(x):  # the long radial closed form's matched at the history's own point
+        series = series_at(design, modulus_function(design), *history_point(x, dt), "the force history")
     if series is None:
         scale, strain = force_per_stress(design), design.strain(x)
     else:  # the rubber's strain through the bulk spring in series, the whole history at once

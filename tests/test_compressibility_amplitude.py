@@ -178,6 +178,26 @@ def test_a_harmonic_force_history_reaches_the_steady_loop(mode):
     assert abs(abs(k) / abs(k_loop) - 1) < 3e-3 and abs(k.imag / k.real - k_loop.imag / k_loop.real) < 1e-3
 
 
+def test_the_long_radial_force_history_reaches_its_steady_loop():
+    """The long radial closed form with K (K/µ 50 and the issue's 1.9 GPa): one tone's force
+    history, its series matched at the history's dominant frequency and peak drive
+    (core.compressible.history_point), against the steady loop matched at the same point: the
+    third period within 0.5 % RMS less the mean (measured 0.003–0.21 %), the first harmonic
+    within 0.3 % and 0.001 of core.stiffness."""
+    for bulk in (50 * ISSUE.material.shear_modulus, 1.9e9):
+        design = ISSUE.in_mode("radial").replace(shape="long", bulk_modulus=bulk)
+        f, steps, xa = 10.0, 1000, design.drive(1e-3)
+        dt = 1 / (f * steps)
+        t = dt * np.arange(1, 3 * steps + 1)
+        last = force_history(design, xa * np.sin(2 * np.pi * f * t), dt).force[-steps:]
+        lp = loop(design, f, xa, steps)
+        ours = np.roll(lp.force, -1)
+        diff = last - ours
+        assert np.sqrt(np.mean((diff - diff.mean()) ** 2)) < 5e-3 * np.sqrt(np.mean(ours**2))
+        k, k0 = first_harmonic(np.roll(lp.phase, -1), last, xa), complex(stiffness(design, f, xa).stiffness[0, 0])
+        assert abs(abs(k) / abs(k0) - 1) < 3e-3 and abs(k.imag / k.real - k0.imag / k0.real) < 1e-3
+
+
 def test_without_a_bulk_modulus_the_force_history_is_as_before():
     """No bulk modulus: F = S σ[c x]/(2c) bit for bit."""
     design = ISSUE.replace(bulk_modulus=None).in_mode("radial")
@@ -217,5 +237,9 @@ def test_a_loop_fit_honours_the_bulk_modulus():
     incompressible = fit_global(start.replace(bulk_modulus=None), loop=measured, free=free, starts=2, intervals=False)
     assert incompressible.loop_rms > 100 * fitted.loop_rms
     assert abs(incompressible.design.material.shear_modulus / design.material.shear_modulus - 1) > 0.05
-    with pytest.raises(ValueError, match="long radial closed form .* a fit to a measured loop"):
-        fit_global(start.replace(shape="long"), loop=measured, free=free, starts=2, intervals=False)
+    # the long radial closed form: its series matched at the measured loop's frequency and amplitude
+    long = design.replace(shape="long")
+    measured = synthetic_loop(long, 0.1, design.drive(2e-3), noise=0.0)
+    fitted = fit_global(start.replace(shape="long"), loop=measured, free=free, starts=2, intervals=False)
+    for name in free:
+        assert getattr(fitted.design.material, name) == pytest.approx(getattr(long.material, name), rel=1e-5)

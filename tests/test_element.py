@@ -103,10 +103,23 @@ def test_bulk_spring_in_series_matches_the_compressible_stiffness_at_small_ampli
         assert abs(abs(k) / abs(k0) - 1) < 0.01 and abs(k.imag / k.real - k0.imag / k0.real) < 0.005
 
 
-def test_long_radial_bulk_modulus_is_refused():
-    design = PAPER_B.replace(shape="long", bulk_modulus=1e9)
-    with pytest.raises(ValueError, match="no series form"):
-        coefficients(design)
+def test_long_radial_bulk_modulus_is_matched_at_the_reference_point():
+    """The long radial closed form with K: the series matched at 10 Hz and ε̂ 1e-3
+    (core.compressible.REFERENCE_FREQUENCY, REFERENCE_STRAIN); the element driven there draws
+    the closed form's stiffness (core.stiffness) within 1 % and 0.005 (the element's own step
+    error; docs/element.md states the bound away from that point), where the bulk modulus moves
+    it more than 5 %."""
+    from core.compressible import REFERENCE_FREQUENCY, REFERENCE_STRAIN
+
+    design = PAPER_B.replace(shape="long", inner_radius=0.02, outer_radius=0.025, length=0.05, bulk_modulus=0.3e9)
+    co = coefficients(design, band=(0.1, 20.0))
+    assert co.channels["dx"].compliance > 0 and co.channels["dz"].compliance == 0
+    d = design.in_mode("radial")
+    amp = d.drive(REFERENCE_STRAIN)
+    k = _first_harmonic(Element(co, ("dx",)), amp, REFERENCE_FREQUENCY, 800, periods=3)
+    k0 = stiffness(d, REFERENCE_FREQUENCY, amp).stiffness[0, 0]
+    assert abs(stiffness(d.replace(bulk_modulus=None), REFERENCE_FREQUENCY, amp).stiffness[0, 0] / k0 - 1) > 0.05
+    assert abs(abs(k) / abs(k0) - 1) < 0.01 and abs(k.imag / k.real - k0.imag / k0.real) < 0.005
 
 
 @pytest.mark.parametrize("effects, words", [

@@ -9,8 +9,10 @@ derives slices (axial and torsion with the long shape factors); elsewhere one la
 
 The bulk modulus: where the finite-length table's series law holds, a shear layer in series
 with the compliance C_b (:func:`core.compressible.bulk_series`, the one place of that form; the
-hysteresis loop uses it too). The long radial closed form of a compressible rubber has no series
-form within 0.3 % (up to 4.7 % off at K/µ 50) and is refused.
+hysteresis loop uses it too). The long radial closed form of a compressible rubber has no global
+series form; its series is matched at one operating point (:func:`core.compressible.series_at`
+at :data:`core.compressible.REFERENCE_FREQUENCY` and :data:`core.compressible.REFERENCE_STRAIN`),
+exact there and within the bound docs/element.md states elsewhere.
 """
 
 from __future__ import annotations
@@ -18,8 +20,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import NamedTuple
 
-from ..bushing import STRUCTURAL_EFFECTS
-from ..compressible import bulk_series
+from ..bushing import STRUCTURAL_EFFECTS, modulus_function
+from ..compressible import REFERENCE_FREQUENCY, REFERENCE_STRAIN, bulk_series, series_at
 from ..design import Design
 from ..parameters import MODE, THESIS_MODES
 from ..slices import slice_nodes
@@ -209,7 +211,8 @@ def channel_coefficients(design: Design, slices: int = 1) -> ChannelCoefficients
         S = tuple(float(1.0 / q) for q in nodes.q)
         c = tuple(float(p / (2.0 * q)) for p, q in zip(nodes.p, nodes.q, strict=True))
         return ChannelCoefficients(design.mode, design.shape_kind, S, c, 0.0, True)
-    series = bulk_series(design)
+    series = bulk_series(design) if design.shape_kind != "long" else series_at(
+        design, modulus_function(design), REFERENCE_FREQUENCY, design.drive(REFERENCE_STRAIN), "the time-domain element")
     if series is None:
         s, c, compliance = design.shape_factor, design.strain_factor, 0.0
     else:
@@ -239,7 +242,7 @@ def coefficients(design: Design, slices: int = 1, band=DEFAULT_BAND) -> Coeffici
     ------
     ValueError
         If ``slices`` or ``band`` is not allowed, a channel's design has an effect without a
-        time-domain form, or a bulk modulus acts where no series form exists (long radial).
+        time-domain form.
     """
     slices = check_slices(slices)
     band = check_band(band)

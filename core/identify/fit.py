@@ -32,7 +32,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..bushing import check_measured_amplitude, stiffness_points
-from ..compressible import bulk_series
 from ..data import MAX_FIT_POINTS, MAX_FIT_SAMPLES, MeasuredLoop, MeasuredStiffness
 from ..design import Design
 from ..loops import steady_loop_force
@@ -386,7 +385,6 @@ def fit_global(design: Design, data: MeasuredStiffness | None = None, loop: Meas
     if data is not None:
         check_data_amplitudes(design, data)  # the measured amplitudes, for this bushing
     if loop is not None:
-        bulk_series(design, "a fit to a measured loop")  # the long radial closed form with K: refused by name
         check_measured_amplitude(design, loop.harmonic()[1], "the loop's amplitude")
         loop.check_force()  # after the amplitude: a displacement in wrong units is named as such
     n = (0 if data is None else 2 * len(data)) + (0 if loop is None else loop.force.size)
