@@ -31,11 +31,13 @@ def card_basis(design: Design) -> Design:
 
 def shape_used(design: Design, mode: str | None = None) -> str:
     """The shape factor ``design``'s setting gives direction ``mode`` (default: its own), in a
-    few words: "long-bushing formula (eq 18)" or "finite-length table"."""
+    few words: "long-bushing formula (eq 18)", "long-bushing closed form (plane strain)" (radial:
+    no equation of the thesis) or "finite-length table"."""
     mode = mode or design.mode
-    if design.shape != "finite" and mode in THESIS_MODES:  # the thesis' closed forms (docs/model.md)
-        return f"long-bushing formula (eq {MODE[mode].long_equation})"
-    return "finite-length table"
+    if design.in_mode(mode).shape_kind != "long":
+        return "finite-length table"
+    equation = MODE[mode].long_equation  # the thesis' closed forms (docs/model.md)
+    return f"long-bushing formula (eq {equation})" if equation else "long-bushing closed form (plane strain)"
 
 
 def shape_phrase(design: Design, modes: tuple[str, ...] | None = None) -> str:
@@ -49,13 +51,19 @@ def shape_phrase(design: Design, modes: tuple[str, ...] | None = None) -> str:
             + (", matched to the plane-strain closed form at this frequency and amplitude" if design.shape_kind == "long"
                else "") + "); the branches are the material's (incompressible).")
         return f"Shape factor: {shape_used(design)}.{bulk}"
-    long = [m for m in modes if shape_used(design, m) != "finite-length table"]
-    finite = [m for m in modes if m not in long]
-    if not long:
+    used = {m: shape_used(design, m) for m in modes}
+    long = [m for m in modes if used[m].startswith("long-bushing formula")]
+    plane = [m for m in modes if used[m] == "long-bushing closed form (plane strain)"]
+    finite = [m for m in modes if used[m] == "finite-length table"]
+    if len(finite) == len(modes):
         return "Shape factor: finite-length table, every direction."
-    plural = "s" if len(long) > 1 else ""
-    eqs = ", ".join(str(MODE[m].long_equation) for m in long)
-    parts = [f"{' and '.join(long)}, long-bushing formula{plural} (eq{plural} {eqs})"]
+    parts = []
+    if long:
+        plural = "s" if len(long) > 1 else ""
+        eqs = ", ".join(str(MODE[m].long_equation) for m in long)
+        parts.append(f"{' and '.join(long)}, long-bushing formula{plural} (eq{plural} {eqs})")
+    if plane:
+        parts.append(f"{' and '.join(plane)}, long-bushing closed form (plane strain)")
     if finite:
         parts.append(f"{' and '.join(finite)}, finite-length table")
     return "Shape factor: " + "; ".join(parts) + "."

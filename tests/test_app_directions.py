@@ -100,3 +100,23 @@ def test_exports_and_the_plotting_api_in_a_new_direction(app):
     np.testing.assert_allclose(values[first, 4], ref.magnitude[0, first], rtol=1e-10)
     layout = card_plots(PAPER_B, 10.0)
     assert isinstance(layout, hv.Layout) and len(layout) == 6
+
+
+def test_a_long_radial_bushing_is_named_by_its_closed_form():
+    """A design set to the long shape uses the plane-strain closed form in the radial direction
+    (core.shape: no thesis equation, not the table), conical keeps the table: each named so, in
+    one direction and across all four."""
+    from app.shapes import shape_phrase, shape_used
+    from core.shape import shape_factor
+
+    design = PAPER_B.replace(shape="long")
+    radial = design.in_mode("radial")
+    assert radial.shape_kind == "long"
+    assert radial.shape_factor == shape_factor(radial.geometry, "radial", "long")
+    assert radial.shape_factor != shape_factor(radial.geometry, "radial", "finite")
+    assert shape_used(design, "radial") == "long-bushing closed form (plane strain)"
+    assert shape_used(design, "conical") == "finite-length table"
+    assert shape_phrase(radial) == "Shape factor: long-bushing closed form (plane strain)."
+    assert shape_phrase(design, ("axial", "torsion", "radial", "conical")) == (
+        "Shape factor: axial and torsion, long-bushing formulas (eqs 18, 17); radial, long-bushing closed "
+        "form (plane strain); conical, finite-length table.")
