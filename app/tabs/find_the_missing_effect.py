@@ -57,6 +57,7 @@ PLOT_COLUMNS = {"gap": 1, "curves": 2, "maps": 2}
 # meanwhile, so that a click on *Diagnose* waits for the group being built, not for every group
 # (a next-tick chain let the three groups run before the click's message was read: 1.4 s)
 PREPARE_GAP_MS = 30
+PROGRESS_HEIGHT = 44  # px: the progress' box, beside the Diagnose button
 
 
 class DiagnosisView(pn.viewable.Viewer):
@@ -78,13 +79,17 @@ class DiagnosisView(pn.viewable.Viewer):
         self.run = pn.widgets.Button(label="Diagnose", color="primary",
                                      description=tip("Fit the baseline and every candidate effect; name what is missing."))
         self.run.on_click(self._run)
-        self.progress = pn.indicators.Progress(value=0, max=100, visible=False, sizing_mode="stretch_width",
-                                               bar_color="primary")
-        self.progress_text = pn.pane.HTML("", sizing_mode="stretch_width")
+        # the progress (a bar and the step) in the text of one pane of a fixed height beside the
+        # button: a widget shown and hidden, a button's state changed or the page's height changed
+        # lays the whole page out again in the browser (30–100 ms each, Chromium's profiler), at
+        # the click and again with the report; a text in a box of its own size does not
+        self.progress_text = pn.pane.HTML("", sizing_mode="stretch_width", height=PROGRESS_HEIGHT,
+                                          styles={"overflow": "hidden"})
         self.message = pn.pane.HTML("", sizing_mode="stretch_width")
         self.source = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.report = pn.pane.Markdown("", sizing_mode="stretch_width")
-        self.use = pn.widgets.Button(label="Use the final model in the explorer", color="success", disabled=True)
+        # the report's buttons are shown with the report only (in _results): never disabled
+        self.use = pn.widgets.Button(label="Use the final model in the explorer", color="success")
         self.use.on_click(lambda _e: state.use_final())
         self.reveal = pn.widgets.Button(label="Reveal the truth", color="warning", visible=False)
         self.reveal.on_click(lambda _e: setattr(state, "revealed", True))
@@ -92,10 +97,10 @@ class DiagnosisView(pn.viewable.Viewer):
         self.curve_key = pn.pane.HTML("", sizing_mode="stretch_width")
         self.download_report = pn.widgets.FileDownload(
             callback=lambda: io.StringIO(state.report_json()), filename="bushing-diagnosis.json",
-            label="Report (JSON)", disabled=True)
+            label="Report (JSON)")
         self.download_predictions = pn.widgets.FileDownload(
             callback=lambda: io.StringIO(state.predictions_csv()), filename="bushing-predictions.csv",
-            label="Predictions (CSV)", disabled=True)
+            label="Predictions (CSV)")
         self.live: dict[str, LivePlot] = {}  # "gap", "curves", "maps": built with the first result
         self._prepared = 0  # how many data sets the plots were made ready for: a newer one stops an older
         self._plot_holders = {name: pn.Column(sizing_mode="stretch_width") for name in ("gap", "curves", "maps")}
@@ -149,9 +154,11 @@ class DiagnosisView(pn.viewable.Viewer):
         self.state.param.update(progress=fraction, progress_message=message)
 
     def _on_progress(self, *_events):
-        self.progress.value = round(100 * self.state.progress)
-        self.progress_text.object = (f'<i class="diagnosis-progress">{self.state.progress_message}…</i>'
-                                     if self.state.running else "")
+        s = self.state
+        self.progress_text.object = (f'<progress class="diagnosis-bar" max="100" value="{round(100 * s.progress)}" '
+                                     f'style="width: 100%; height: 0.7em; margin: 0"></progress><br>'
+                                     f'<i class="diagnosis-progress" style="font-size: 0.9em">{s.progress_message}…</i>'
+                                     if s.running else "")
 
     def _on_data(self, *_events):
         """New data: the report's plots are made ready for them once the data are on the page
@@ -224,13 +231,10 @@ class DiagnosisView(pn.viewable.Viewer):
                                   f"{format_value(d.frequency_hz.max(), 'Hz', 'frequency')}; {'; '.join(per_mode)}.")
         else:
             self.source.object = "_No data loaded yet._"
-        self.run.disabled = s.running or s.data is None
-        self.run.loading = s.running
-        self.progress.visible = s.running
+        self.run.disabled = s.data is None  # a click while it runs is ignored (_run)
         self._on_progress()
         r = s.result
         self._results.visible = r is not None
-        self.use.disabled = self.download_report.disabled = self.download_predictions.disabled = r is None
         self.reveal.visible = r is not None and s.mystery is not None and not s.revealed
         self.truth.object = s.truth() if (s.revealed and r is not None) else ""
         if r is None:
@@ -310,9 +314,7 @@ class DiagnosisView(pn.viewable.Viewer):
             shape_pane(self.state.explorer, CARD_MODES),
             self.message,
             "### 2. Baseline and diagnosis",
-            pn.Row(self.baseline, self.run),
-            self.progress,
-            self.progress_text,
+            pn.Row(self.baseline, self.run, self.progress_text, sizing_mode="stretch_width"),
             self._results,
             sizing_mode="stretch_width",
         )
