@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import asyncio
 import io
 import logging
 
@@ -23,7 +24,7 @@ from ..plotting.style import SWEEP_PALETTES, sweep_label
 from ..shapes import shape_pane
 from ..units import amplitude_unit
 from ..uploads import csv_dropper, on_upload, verdict_html
-from ..work import PageClosed, in_thread
+from ..work import PageClosed, in_thread, page_open
 
 log = logging.getLogger("bushing.app")
 
@@ -103,6 +104,8 @@ class DiagnosisView(pn.viewable.Viewer):
             label="Predictions (CSV)")
         self.live: dict[str, LivePlot] = {}  # "gap", "curves", "maps": built with the first result
         self._prepared = 0  # how many data sets the plots were made ready for: a newer one stops an older
+        self._ready: set[str] = set()  # the groups of plots made ready for the loaded data
+        self._overlays: dict | None = None  # what they were made with (_pending)
         self._plot_holders = {name: pn.Column(sizing_mode="stretch_width") for name in ("gap", "curves", "maps")}
         self._results = pn.Column(
             "### 3. What the diagnosis found",
@@ -135,6 +138,11 @@ class DiagnosisView(pn.viewable.Viewer):
             return
         state.param.update(running=True, message="", result=None, revealed=False, progress=0.0,
                            progress_message="fitting the baseline")
+        await asyncio.sleep(0)  # the progress goes to the page first
+        if self._ready != set(PLOT_GROUPS):  # then the groups of plots not yet made ready, before the
+            for name in PLOT_GROUPS:  # work, and their messages written (a page closed while one is
+                self._prepare(name)  # written logged an unretrieved WebSocketClosedError)
+            await asyncio.sleep(PREPARE_GAP_MS / 1000)
         try:  # in a worker process when the server has them (app.work.use_processes)
             result = await in_thread(state.task(), self._show_progress, pn.state.curdoc)
         except PageClosed:
@@ -162,31 +170,40 @@ class DiagnosisView(pn.viewable.Viewer):
 
     def _on_data(self, *_events):
         """New data: the report's plots are made ready for them once the data are on the page
-        (:meth:`_pending`; on a served page the data's message goes first, then one group of plots
-        every :data:`PREPARE_GAP_MS`, so that a click on *Diagnose* waits for one group at most; the
-        groups left go on while the diagnosis runs in its worker, and stop once the report is
-        there: it builds any group still missing)."""
+        (:meth:`_prepare`; on a served page the data's message goes first, then one group of
+        plots every :data:`PREPARE_GAP_MS`, so that a click on *Diagnose* waits for one group at
+        most; the click makes the groups left, after its progress is shown: :meth:`_run`)."""
         self._prepared += 1
+        self._ready, self._overlays = set(), None
         generation, doc = self._prepared, pn.state.curdoc
         served = doc is not None and doc.session_context is not None
 
-        def prepare(i: int, overlays: dict | None = None):
-            if generation != self._prepared or i >= len(PLOT_GROUPS) or self.state.result is not None:
-                return  # newer data came, every group is built, or the report built the rest
-            if overlays is None:
-                overlays = self._pending()
-                if overlays is None:
-                    return
-            update_or_keep("DiagnosisView prepared no plots", lambda: self._plot(PLOT_GROUPS[i], overlays))
+        def prepare(i: int):
+            s = self.state
+            if (generation != self._prepared or i >= len(PLOT_GROUPS) or s.running or s.result is not None
+                    or not page_open(doc)):
+                return  # newer data came, every group is made, the click makes the rest, or the page closed
+            self._prepare(PLOT_GROUPS[i])
             if served:
-                doc.add_timeout_callback(lambda: prepare(i + 1, overlays), PREPARE_GAP_MS)
+                doc.add_timeout_callback(lambda: prepare(i + 1), PREPARE_GAP_MS)
             else:
-                prepare(i + 1, overlays)
+                prepare(i + 1)
 
         if served:
             doc.add_next_tick_callback(lambda: prepare(0))
         else:
             prepare(0)
+
+    def _prepare(self, name: str):
+        """The group ``name`` of the report's plots made ready for the loaded data, once."""
+        if name in self._ready:
+            return
+        if self._overlays is None:
+            self._overlays = self._pending()
+            if self._overlays is None:
+                return
+        update_or_keep("DiagnosisView prepared no plots", lambda: self._plot(name, self._overlays))
+        self._ready.add(name)
 
     def _pending(self) -> dict | None:
         """The report's plots with the shape a diagnosis of the loaded data will give them
