@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import statistics
 import subprocess
 import sys
@@ -142,9 +143,13 @@ def run_tree(tree: Path, runs: int, csv: Path, pause: float = 0.0) -> list[dict]
             measure(page, url, csv)  # warm: the server's first imports and caches
             out = [measure(page, url, csv, pause) for _ in range(runs)]
             browser.close()
-    finally:
-        proc.kill()
-        proc.wait()
+    finally:  # as Ctrl-C: the server stops its worker processes (a kill leaves them running)
+        proc.send_signal(signal.SIGINT)
+        try:
+            proc.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
     return out
 
 

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import asyncio
 import io
 import logging
 
@@ -23,7 +24,7 @@ from ..plotting.style import SWEEP_PALETTES, sweep_label
 from ..shapes import shape_pane
 from ..units import amplitude_unit
 from ..uploads import csv_dropper, on_upload, verdict_html
-from ..work import PageClosed, in_thread
+from ..work import PageClosed, in_thread, page_open
 
 log = logging.getLogger("bushing.app")
 
@@ -53,6 +54,11 @@ def effect_units(effect: str, mode: str) -> dict[str, str]:
 
 PLOT_GROUPS = ("gap", "curves", "maps")  # the report's plots, in the order the page shows them
 PLOT_COLUMNS = {"gap": 1, "curves": 2, "maps": 2}
+# between two groups of plots made ready (a served page): the event loop reads the page's messages
+# meanwhile, so that a click on *Diagnose* waits for the group being built, not for every group
+# (a next-tick chain let the three groups run before the click's message was read: 1.4 s)
+PREPARE_GAP_MS = 30
+PROGRESS_HEIGHT = 44  # px: the progress' box, beside the Diagnose button
 
 
 class DiagnosisView(pn.viewable.Viewer):
@@ -74,13 +80,17 @@ class DiagnosisView(pn.viewable.Viewer):
         self.run = pn.widgets.Button(label="Diagnose", color="primary",
                                      description=tip("Fit the baseline and every candidate effect; name what is missing."))
         self.run.on_click(self._run)
-        self.progress = pn.indicators.Progress(value=0, max=100, visible=False, sizing_mode="stretch_width",
-                                               bar_color="primary")
-        self.progress_text = pn.pane.HTML("", sizing_mode="stretch_width")
+        # the progress (a bar and the step) in the text of one pane of a fixed height beside the
+        # button: a widget shown and hidden, a button's state changed or the page's height changed
+        # lays the whole page out again in the browser (30–100 ms each, Chromium's profiler), at
+        # the click and again with the report; a text in a box of its own size does not
+        self.progress_text = pn.pane.HTML("", sizing_mode="stretch_width", height=PROGRESS_HEIGHT,
+                                          styles={"overflow": "hidden"})
         self.message = pn.pane.HTML("", sizing_mode="stretch_width")
         self.source = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.report = pn.pane.Markdown("", sizing_mode="stretch_width")
-        self.use = pn.widgets.Button(label="Use the final model in the explorer", color="success", disabled=True)
+        # the report's buttons are shown with the report only (in _results): never disabled
+        self.use = pn.widgets.Button(label="Use the final model in the explorer", color="success")
         self.use.on_click(lambda _e: state.use_final())
         self.reveal = pn.widgets.Button(label="Reveal the truth", color="warning", visible=False)
         self.reveal.on_click(lambda _e: setattr(state, "revealed", True))
@@ -88,12 +98,14 @@ class DiagnosisView(pn.viewable.Viewer):
         self.curve_key = pn.pane.HTML("", sizing_mode="stretch_width")
         self.download_report = pn.widgets.FileDownload(
             callback=lambda: io.StringIO(state.report_json()), filename="bushing-diagnosis.json",
-            label="Report (JSON)", disabled=True)
+            label="Report (JSON)")
         self.download_predictions = pn.widgets.FileDownload(
             callback=lambda: io.StringIO(state.predictions_csv()), filename="bushing-predictions.csv",
-            label="Predictions (CSV)", disabled=True)
+            label="Predictions (CSV)")
         self.live: dict[str, LivePlot] = {}  # "gap", "curves", "maps": built with the first result
         self._prepared = 0  # how many data sets the plots were made ready for: a newer one stops an older
+        self._ready: set[str] = set()  # the groups of plots made ready for the loaded data
+        self._overlays: dict | None = None  # what they were made with (_pending)
         self._plot_holders = {name: pn.Column(sizing_mode="stretch_width") for name in ("gap", "curves", "maps")}
         self._results = pn.Column(
             "### 3. What the diagnosis found",
@@ -126,6 +138,11 @@ class DiagnosisView(pn.viewable.Viewer):
             return
         state.param.update(running=True, message="", result=None, revealed=False, progress=0.0,
                            progress_message="fitting the baseline")
+        await asyncio.sleep(0)  # the progress goes to the page first
+        if self._ready != set(PLOT_GROUPS):  # then the groups of plots not yet made ready, before the
+            for name in PLOT_GROUPS:  # work, and their messages written (a page closed while one is
+                self._prepare(name)  # written logged an unretrieved WebSocketClosedError)
+            await asyncio.sleep(PREPARE_GAP_MS / 1000)
         try:  # in a worker process when the server has them (app.work.use_processes)
             result = await in_thread(state.task(), self._show_progress, pn.state.curdoc)
         except PageClosed:
@@ -145,35 +162,48 @@ class DiagnosisView(pn.viewable.Viewer):
         self.state.param.update(progress=fraction, progress_message=message)
 
     def _on_progress(self, *_events):
-        self.progress.value = round(100 * self.state.progress)
-        self.progress_text.object = (f'<i class="diagnosis-progress">{self.state.progress_message}…</i>'
-                                     if self.state.running else "")
+        s = self.state
+        self.progress_text.object = (f'<progress class="diagnosis-bar" max="100" value="{round(100 * s.progress)}" '
+                                     f'style="width: 100%; height: 0.7em; margin: 0"></progress><br>'
+                                     f'<i class="diagnosis-progress" style="font-size: 0.9em">{s.progress_message}…</i>'
+                                     if s.running else "")
 
     def _on_data(self, *_events):
         """New data: the report's plots are made ready for them once the data are on the page
-        (:meth:`_pending`, on the next ticks of a served page: the data's message goes first,
-        then one group of plots a tick, so that a click on *Diagnose* waits for one group at most)."""
+        (:meth:`_prepare`; on a served page the data's message goes first, then one group of
+        plots every :data:`PREPARE_GAP_MS`, so that a click on *Diagnose* waits for one group at
+        most; the click makes the groups left, after its progress is shown: :meth:`_run`)."""
         self._prepared += 1
+        self._ready, self._overlays = set(), None
         generation, doc = self._prepared, pn.state.curdoc
         served = doc is not None and doc.session_context is not None
 
-        def prepare(i: int, overlays: dict | None = None):
-            if generation != self._prepared or i >= len(PLOT_GROUPS):
-                return  # newer data came, or every group is built
-            if overlays is None:
-                overlays = self._pending()
-                if overlays is None:
-                    return
-            update_or_keep("DiagnosisView prepared no plots", lambda: self._plot(PLOT_GROUPS[i], overlays))
+        def prepare(i: int):
+            s = self.state
+            if (generation != self._prepared or i >= len(PLOT_GROUPS) or s.running or s.result is not None
+                    or not page_open(doc)):
+                return  # newer data came, every group is made, the click makes the rest, or the page closed
+            self._prepare(PLOT_GROUPS[i])
             if served:
-                doc.add_next_tick_callback(lambda: prepare(i + 1, overlays))
+                doc.add_timeout_callback(lambda: prepare(i + 1), PREPARE_GAP_MS)
             else:
-                prepare(i + 1, overlays)
+                prepare(i + 1)
 
         if served:
             doc.add_next_tick_callback(lambda: prepare(0))
         else:
             prepare(0)
+
+    def _prepare(self, name: str):
+        """The group ``name`` of the report's plots made ready for the loaded data, once."""
+        if name in self._ready:
+            return
+        if self._overlays is None:
+            self._overlays = self._pending()
+            if self._overlays is None:
+                return
+        update_or_keep("DiagnosisView prepared no plots", lambda: self._plot(name, self._overlays))
+        self._ready.add(name)
 
     def _pending(self) -> dict | None:
         """The report's plots with the shape a diagnosis of the loaded data will give them
@@ -181,7 +211,7 @@ class DiagnosisView(pn.viewable.Viewer):
         numbers into them (:meth:`app.live.LivePlot.show`) instead of HoloViews building seven
         plots after the work (measured: ``benchmarks/diagnosis_report_cpu.py``). None without data."""
         s = self.state
-        data = None if s.data is None or s.running else s.data.of_mode(s.explorer.design.mode)
+        data = None if s.data is None else s.data.of_mode(s.explorer.design.mode)
         if data is None or len(data) == 0:
             return None
         return pending_overlays(data, s.explorer.design.mode)
@@ -218,13 +248,10 @@ class DiagnosisView(pn.viewable.Viewer):
                                   f"{format_value(d.frequency_hz.max(), 'Hz', 'frequency')}; {'; '.join(per_mode)}.")
         else:
             self.source.object = "_No data loaded yet._"
-        self.run.disabled = s.running or s.data is None
-        self.run.loading = s.running
-        self.progress.visible = s.running
+        self.run.disabled = s.data is None  # a click while it runs is ignored (_run)
         self._on_progress()
         r = s.result
         self._results.visible = r is not None
-        self.use.disabled = self.download_report.disabled = self.download_predictions.disabled = r is None
         self.reveal.visible = r is not None and s.mystery is not None and not s.revealed
         self.truth.object = s.truth() if (s.revealed and r is not None) else ""
         if r is None:
@@ -304,9 +331,7 @@ class DiagnosisView(pn.viewable.Viewer):
             shape_pane(self.state.explorer, CARD_MODES),
             self.message,
             "### 2. Baseline and diagnosis",
-            pn.Row(self.baseline, self.run),
-            self.progress,
-            self.progress_text,
+            pn.Row(self.baseline, self.run, self.progress_text, sizing_mode="stretch_width"),
             self._results,
             sizing_mode="stretch_width",
         )
