@@ -280,6 +280,14 @@ class Session(threading.Thread):
         self._pending: float | None = None  # perf_counter when the change in flight was set
         self._answer: float | None = None
         self._closing = False
+        self._counted = False  # the run's count of sessions opened or refused has this one
+
+    def _count(self):
+        """Once: this session has opened, failed or been refused as busy (the changes start when
+        every session has; a refused one keeps asking, as its page does, and drives if let in)."""
+        if not self._counted:
+            self._counted = True
+            self.run_.opened.release()
 
     def run(self):
         try:
@@ -288,8 +296,7 @@ class Session(threading.Thread):
             if self.out.open_s is None and self.out.error is None:
                 self.out.error = f"{type(exc).__name__}: {exc}"[:160]
         finally:
-            if self.out.open_s is None:
-                self.run_.opened.release()
+            self._count()
 
     def _open_and_drive(self):
         from bokeh.client import ClientSession
@@ -314,7 +321,7 @@ class Session(threading.Thread):
             self.out.error = f"{type(exc).__name__}: {code or ''} {detail or exc}".strip()[:160]
             return
         self.out.open_s = time.perf_counter() - t0
-        self.run_.opened.release()
+        self._count()
         doc, conn = session.document, session._connection
         conn._socket._socket.protocol.set_nodelay(True)  # as a browser: every frame sent at once
         for m in doc.models:
@@ -343,11 +350,15 @@ class Session(threading.Thread):
                 break
             except urllib.error.HTTPError as exc:
                 body = exc.read().decode("utf-8", "replace")
-                if exc.code != 503 or self.run_.past():
+                if exc.code != 503:
                     raise
+                if self.run_.past():
+                    raise TimeoutError("refused as busy until the time limit") from None
                 self.out.busy += 1
+                self._count()
                 self.out.busy_reason = re.search(r"<h1>(.*?)</h1>", body).group(1) if "<h1>" in body else body[:80]
-                time.sleep(min(30.0, float(exc.headers.get("Retry-After") or 5)))
+                wait = min(30.0, float(exc.headers.get("Retry-After") or 5))
+                time.sleep(max(0.0, min(wait, self.run_.deadline - time.monotonic())))
         token = re.search(r'"token":\s*"([^"]+)"', page)
         if token is None:
             raise RuntimeError("no session token in the page")
