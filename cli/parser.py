@@ -170,7 +170,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="The bushing card: the dynamic stiffness in the four directions at one "
         f"frequency, {' and '.join(TRANSLATIONS)} at D {CARD_DISPLACEMENT.display}, {' and '.join(ROTATIONS)} "
         "at R rad, with finite-length "
-        "shape factors (the design's shape 'long' keeps the closed forms for axial and torsion). "
+        "shape factors (the design's shape 'thesis' keeps the closed forms for axial and torsion). "
         "Writes CSV with columns mode, amplitude (m or rad), stiffness_real, stiffness_imag, "
         "magnitude, loss_factor, shape_factor.",
     )

@@ -202,6 +202,10 @@ MODE_TABLE: tuple[Mode, ...] = (
 MODE = {m.name: m for m in MODE_TABLE}
 MODES = tuple(MODE)
 SHAPES = ("long", "finite")  # closed forms of long bushings, or the finite-length table
+# the design file's words for them (docs/files.md): "thesis" names the long-bushing closed forms
+# (the thesis' eqs 17 and 18); "long", this project's earlier word, is read as the same
+FILE_SHAPE = {"long": "thesis", "finite": "finite"}
+SHAPE_FROM_FILE = {"thesis": "long", "long": "long", "finite": "finite"}
 DEFAULT_SHAPE = {m.name: m.default_shape for m in MODE_TABLE}
 TRANSLATIONS = tuple(m.name for m in MODE_TABLE if not m.rotation)  # amplitude in m, stiffness in N/m
 ROTATIONS = tuple(m.name for m in MODE_TABLE if m.rotation)  # amplitude in rad, stiffness in N·m/rad
@@ -221,4 +225,4 @@ def no_long_form(mode_name: str) -> str | None:
     """Why ``mode_name`` has no shape ``long`` (its rule's words), or None where it has one."""
     if MODE[mode_name].long_form:
         return None
-    return f"{mode_name}: no closed form holds for bushings of real length; use shape 'finite'"
+    return f"{mode_name}: no closed form holds for bushings of real length (shape 'thesis'); use shape 'finite'"

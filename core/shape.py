@@ -214,8 +214,8 @@ class ShapeTable:
         if not (lo_r <= radius_ratio <= hi_r and lo_l <= length_ratio <= hi_l):
             raise OutsideTable(
                 f"the finite-length shape factors cover b/a {lo_r:g}–{hi_r:g} and L/(b − a) {lo_l:g}–{hi_l:g}; "
-                f"this bushing has b/a {radius_ratio:.3g} and L/(b − a) {length_ratio:.3g} (use shape 'long' "
-                f"for axial or torsion)")
+                f"this bushing has b/a {radius_ratio:.3g} and L/(b − a) {length_ratio:.3g} (use shape 'thesis', the long-bushing "
+                f"closed forms, for axial or torsion)")
         # the spline interpolates ln(ratio): its exp stays positive and smooth
         return math.exp(float(self.splines[mode](math.log(radius_ratio), math.log(length_ratio))[0, 0]))
 

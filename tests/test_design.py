@@ -224,3 +224,35 @@ def test_every_direction_and_the_shape_round_trip():
     data["shape"] = "short"
     with pytest.raises(DesignError, match="shape"):
         design_from_dict(data)
+
+
+def test_the_shape_words_of_the_design_file():
+    """The design file's ``shape`` is ``thesis`` or ``finite`` (docs/files.md): ``thesis`` gives the
+    long-bushing closed forms, eq 18 axially (2πL / ln(b/a), computed here), and is what a file is
+    written with; ``long``, the word earlier versions wrote, reads as the same design; anything
+    else, or ``thesis`` for the conical direction, is refused by its key."""
+    from core.io.design_file import design_from_dict
+
+    a, b, length = (PAPER_B.geometry.inner_radius, PAPER_B.geometry.outer_radius, PAPER_B.geometry.length)
+    for word in ("thesis", "long"):
+        data = paper_b_dict()
+        data["shape"] = word
+        design = design_from_dict(data)
+        assert design.shape_kind == "long"
+        assert design.shape_factor == pytest.approx(2 * math.pi * length / math.log(b / a), rel=1e-12)
+        assert json.loads(dumps_design(design))["shape"] == "thesis"
+    finite = paper_b_dict()
+    finite["shape"] = "finite"
+    assert json.loads(dumps_design(design_from_dict(finite)))["shape"] == "finite"
+    for word, rule in [("Thesis", "must be one of thesis, finite, got 'Thesis'"), (18, "must be one of thesis, finite, got 18"),
+                       ("short", "must be one of thesis, finite")]:
+        data = paper_b_dict()
+        data["shape"] = word
+        with pytest.raises(DesignError, match=rule) as caught:
+            design_from_dict(data)
+        assert caught.value.key == "shape"
+    conical = paper_b_dict()
+    conical.update(mode="conical", shape="thesis")
+    with pytest.raises(DesignError, match="no closed form") as caught:
+        design_from_dict(conical)
+    assert caught.value.key == "shape"

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from ..design import Design
-from ..parameters import GEOMETRY, MATERIAL, MODES, OPTIONAL
+from ..parameters import FILE_SHAPE, GEOMETRY, MATERIAL, MODES, OPTIONAL, SHAPE_FROM_FILE
 from ..parts import Geometry, Material, check_bulk_ratio
 from ..rules import (
     BAD_CHOICE,
@@ -65,6 +65,9 @@ def design_from_dict(data: Any) -> Design:
         raise DesignError("fit", "must be an object (the report of `bushing fit`)", BAD_TYPE)
     if not isinstance(data["mode"], str):
         raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {data['mode']!r}", BAD_CHOICE)
+    shape = data.get("shape")
+    if shape is not None and (not isinstance(shape, str) or shape not in SHAPE_FROM_FILE):
+        raise DesignError("shape", f"must be one of {', '.join(FILE_SHAPE.values())}, got {shape!r}", BAD_CHOICE)
     material = Material(**data["material"])
     check_bulk_ratio(material)
     return Design(
@@ -73,7 +76,7 @@ def design_from_dict(data: Any) -> Design:
         material=material,
         name=data.get("name"),
         effects=data.get("effects", {}),
-        shape=data.get("shape"),
+        shape=None if shape is None else SHAPE_FROM_FILE[shape],
     )
 
 
