@@ -18,7 +18,6 @@ from .bands import band_tolerances, banded
 from .curves import amplitude_grid, fletcher_gent_amplitudes
 from .fit_state import FitState
 from .inputs import copy_link_button
-from .shapes import card_basis
 from .state import ExplorerState
 from .units import to_si_amplitude
 
@@ -80,12 +79,10 @@ class ExportView(pn.viewable.Viewer):
         fmt, _ = TOOL_FORMATS[label]
         x = float(to_si_amplitude(s.amplitude, s.design.mode))
         if fmt == "adams":
-            design, (x,) = _basis(s.design, [x])
-            return export(design, "adams", [s.frequency_hz], [x])
+            return export(s.design, "adams", [s.frequency_hz], [x])
         freqs = np.geomspace(s.freq_min, s.freq_max, 30)
         amps = [x, *(float(to_si_amplitude(a, s.design.mode)) for a in fletcher_gent_amplitudes(s.design))]
-        design, amps = _basis(s.design, amps)
-        return export(design, "table" if fmt.startswith("table") else fmt, freqs, amps, as_json=fmt == "table-json")
+        return export(s.design, "table" if fmt.startswith("table") else fmt, freqs, amps, as_json=fmt == "table-json")
 
     def _tool_file(self):
         return io.StringIO(self.tool_text(self.tool_format.value))
@@ -105,13 +102,3 @@ class ExportView(pn.viewable.Viewer):
             sizing_mode="stretch_width",
         )
 
-
-def _basis(design, amplitudes: list[float]) -> tuple:
-    """(design, amplitudes) as the exports (:mod:`core.io.export`) take them to use the
-    explorer's shape factors in every direction (:func:`app.shapes.card_basis`): the
-    amplitudes (SI, of ``design``'s mode) moved to the same equivalent strains in the mode of
-    the design they get, if it is another."""
-    basis = card_basis(design)
-    if basis.mode == design.mode:
-        return basis, amplitudes
-    return basis, [float(basis.drive(design.strain(a))) for a in amplitudes]

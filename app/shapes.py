@@ -12,21 +12,8 @@ from __future__ import annotations
 
 from core import Design
 from core.numbers import format_value
-from core.parameters import BY_NAME, MODE, THESIS_MODES
+from core.parameters import BY_NAME, MODE
 from core.shape import pure_shear
-
-
-def card_basis(design: Design) -> Design:
-    """``design`` as the bushing card (:mod:`core.card`) and the exports (:mod:`core.io.export`)
-    must get it to use the explorer's setting in every direction: their convention is the
-    finite-length table unless the design's ``shape`` is ``long``, so a design on the long
-    setting says so explicitly (in a mode without a long form, taken into the first one that
-    has: the card uses the design's mode for a rig's apparent mass only, which goes with it)."""
-    if design.shape == "finite":
-        return design
-    if design.mode in THESIS_MODES:
-        return design if design.shape == "long" else design.replace(shape="long")
-    return design.in_mode(THESIS_MODES[0]).replace(shape="long")
 
 
 def shape_used(design: Design, mode: str | None = None) -> str:

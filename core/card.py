@@ -1,9 +1,10 @@
 """The bushing card: the dynamic stiffness in every direction at one operating point.
 
 Axial and radial at a displacement amplitude, torsion and conical at an angle amplitude, all from
-the same material and geometry, with finite-length shape factors (a design whose ``shape`` is
-``long`` keeps the closed forms for axial and torsion; radial and conical are always finite, the
-plane-strain radial formula being about twice too stiff for real lengths). Plus the ratios
+the same material and geometry, each direction with the shape factor the design file's rule gives
+it (docs/files.md): the thesis' closed forms for axial and torsion unless the design's ``shape``
+is ``finite``, the finite-length table for radial and conical always (the plane-strain radial
+formula is about twice too stiff for real lengths). Plus the ratios
 engineers quote: radial / axial, and radial / the torsion-equivalent translational stiffness
 K_torsion / r_m², r_m = (a + b)/2 (the circumferential stiffness at the mean radius).
 """
@@ -23,9 +24,11 @@ CARD_MODES = TRANSLATIONS + ROTATIONS  # axial, radial, torsion, conical
 
 
 def card_design(design: Design, mode: str) -> Design:
-    """``design`` in ``mode`` with the card's shape factor (a test rig's apparent mass stays
-    with its own mode, as :meth:`core.design.Design.in_mode` keeps it)."""
-    shape = design.shape if design.shape == "long" and mode in THESIS_MODES else "finite"
+    """``design`` in ``mode`` with the card's shape factor: the closed forms (``long``) for axial
+    and torsion unless ``design``'s ``shape`` is ``finite``, the finite-length table for radial and
+    conical (a test rig's apparent mass stays with its own mode, as
+    :meth:`core.design.Design.in_mode` keeps it)."""
+    shape = "long" if mode in THESIS_MODES and design.shape != "finite" else "finite"
     return design.replace(mode=mode, shape=shape, effects=design.portable_effects)
 
 

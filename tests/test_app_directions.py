@@ -7,7 +7,6 @@ import pytest
 
 from app import units
 from app.main import App
-from app.shapes import card_basis
 from core import PAPER_B, stiffness
 from core.bushing import shape_factor, strain_factor
 from core.card import card
@@ -64,7 +63,7 @@ def test_the_card_tab_holds_the_core_card(app):
     view = app.card
     app.tabs.active = [t for t, *_ in App.LAZY_TABS].index("Every direction") + 1  # shown: it refreshes
     view.param.update(displacement_mm=0.2, angle_rad=0.02)
-    rows = card(card_basis(app.state.design), app.state.frequency_hz, 0.2e-3, 0.02)
+    rows = card(app.state.design, app.state.frequency_hz, 0.2e-3, 0.02)
     # the axial row is the explorer's own stiffness (one shape-factor setting): long by default
     explorer_axial = stiffness(app.state.design, app.state.frequency_hz, 0.2e-3).magnitude[0, 0]
     assert rows[0]["mode"] == "axial" and rows[0]["magnitude"] == pytest.approx(explorer_axial, rel=1e-12)

@@ -228,3 +228,43 @@ def test_the_command_line_loads_the_browser_libraries_only_to_serve(designs, tmp
                          capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
     assert (tmp_path / "card.csv").read_text().startswith("mode,")
+
+
+@pytest.mark.parametrize("shape", [None, "thesis", "finite"])
+def test_card_and_export_give_each_direction_the_stiffness_of_its_design_file(shape, capsys, tmp_path):
+    """One design file, one number per direction, whatever the command (docs/files.md: without a
+    shape, the closed forms for axial and torsion and the table for radial and conical; ``finite``,
+    the table everywhere): the card's rows and the export's rows of the design's own mode are
+    `bushing stiffness` of the same file taken into that direction."""
+    base = json.loads(json.dumps(PAPER_B.to_dict()))
+    if shape is not None:
+        base["shape"] = shape
+    amplitude = {"axial": 1e-4, "radial": 1e-4, "torsion": 0.01, "conical": 0.01}
+    expected = {}
+    for mode, x in amplitude.items():
+        data = dict(base, mode=mode)
+        if mode in ("radial", "conical") and shape == "thesis":
+            data.pop("shape")  # no closed form of the thesis in these directions: the table
+        path = tmp_path / f"{mode}.json"
+        path.write_text(json.dumps(data), encoding="utf-8")
+        status, out, err = run(["stiffness", path, "--freq", 10, 10, 1, "--amp", x], capsys)
+        assert status == 0, err
+        expected[mode] = read_csv(out)[1][0, 4]
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps(base), encoding="utf-8")
+    status, out, err = run(["card", path, "--freq", 10, "--amp-mm", 0.1, "--amp-rad", 0.01], capsys)
+    assert status == 0, err
+    rows = list(csv.DictReader(io.StringIO(out)))
+    assert [r["mode"] for r in rows] == ["axial", "radial", "torsion", "conical"]
+    for r in rows:
+        assert float(r["magnitude"]) == pytest.approx(expected[r["mode"]], rel=1e-10)
+    status, out, err = run(["export", path, "--format", "table", "--freq", 10, 10, 1, "--amp", 1e-4], capsys)
+    assert status == 0, err
+    axial = [r for r in csv.DictReader(io.StringIO(out)) if r["mode"] == "axial"]
+    assert float(axial[0]["magnitude"]) == pytest.approx(expected["axial"], rel=1e-10)
+    table = stiffness(PAPER_B.replace(shape="finite"), [10.0], [1e-4]).magnitude[0, 0]
+    if shape == "finite":
+        assert expected["axial"] == pytest.approx(table, rel=1e-10)
+    else:  # eq 18's closed form: 3.5 % stiffer than the finite-length table for Paper B
+        assert expected["axial"] == pytest.approx(stiffness(PAPER_B, [10.0], [1e-4]).magnitude[0, 0], rel=1e-10)
+        assert expected["axial"] > 1.03 * table

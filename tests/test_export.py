@@ -185,8 +185,6 @@ def test_grid_amplitudes_follow_the_equivalent_strain():
 def test_the_explorers_export_panel_writes_every_tool_format():
     from app.export import TOOL_FORMATS
     from app.main import App
-    from app.shapes import card_basis
-
     app = App()
     app.state.amplitude = 0.2  # mm
     texts = {label: app.export.tool_text(label) for label in TOOL_FORMATS}
@@ -194,14 +192,14 @@ def test_the_explorers_export_panel_writes_every_tool_format():
     assert len([c for c in cards if c[0] == "PBUSH"]) == 6  # the operating amplitude and five more
     adams_file = adams_sections(texts["Adams bushing file (.bus)"])
     # the explorer's shape factors (long-bushing axial, by default): the explorer's own stiffness
-    _, k = expected("axial", 0.2e-3, app.state.frequency_hz, card_basis(app.state.design))
+    _, k = expected("axial", 0.2e-3, app.state.frequency_hz, app.state.design)
     assert abs(k - stiffness_points(app.state.design, app.state.frequency_hz, 0.2e-3)) <= 1e-12 * abs(k)
     slope = np.polyfit(*np.array(adams_file["Z_FORCE_CURVE"]["rows"]).T, 1)[0]
     assert slope == pytest.approx(k.real, rel=1e-8)
     table = pd.read_csv(io.StringIO(texts["Neutral table, every direction (CSV)"]))
     assert table["frequency_hz"].nunique() == 30 and set(table["mode"]) == set(CARD_MODES)
     header = json.loads(texts["Neutral table, every direction (JSON)"])["header"]
-    assert header["design"] == card_basis(app.state.design).to_dict()
+    assert header["design"] == app.state.design.to_dict()
     app.export.tool_format.value = "Adams bushing file (.bus)"
     assert app.export.tool_file.filename == "bushing.bus"
 

@@ -8,7 +8,6 @@ from core import Design
 from core.parameters import ROTATIONS, TRANSLATIONS
 
 from .. import curves
-from ..shapes import card_basis
 from ..units import ROTATION, TRANSLATION
 from .style import (
     MODE_COLORS,
@@ -83,7 +82,7 @@ def card_plots(design: Design, frequency_hz: float = 10.0, displacement: float =
     ----------
     design : Design
         The bushing, in SI units, in any mode: the card takes it into every mode, with the
-        explorer's shape factors (:func:`app.shapes.card_basis`: the finite-length table in every
+        card's shape factors (:func:`core.card.card_design`: the finite-length table in every
         direction if its ``shape`` is ``finite``, else the long-bushing formulas of axial and
         torsion).
     frequency_hz : float, default 10.0
@@ -102,7 +101,7 @@ def card_plots(design: Design, frequency_hz: float = 10.0, displacement: float =
         of torsion and conical (N·m/rad) against angle (rad), each on its own axes, and the
         loss factors (dimensionless) of the translations and of the rotations.
     """
-    data = curves.card_sweeps(card_basis(design), frequency_hz)
+    data = curves.card_sweeps(design, frequency_hz)
     at = {"translation": TRANSLATION.amplitude.to_display(displacement),
           "rotation": ROTATION.amplitude.to_display(angle)}
     return sized(hv.Layout(list(card_overlays(data, card_dimensions(), at).values())).cols(2), width)

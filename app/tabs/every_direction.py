@@ -20,7 +20,7 @@ from ..live import LivePlot
 from ..number_field import NumberField
 from ..plotting.every_direction import card_dimensions, card_overlays
 from ..plotting.style import ranged
-from ..shapes import card_basis, shape_pane, shape_used
+from ..shapes import shape_pane, shape_used
 from ..state import ExplorerState
 from ..units import ROTATION, TRANSLATION
 from ..views import PlotView
@@ -66,7 +66,7 @@ class CardView(PlotView):
         return self.plots.current[WHICH.index(which)]
 
     def _update(self):
-        design, f = card_basis(self.state.design), self.state.frequency_hz
+        design, f = self.state.design, self.state.frequency_hz
         reference = self.state.reference
         x = float(TRANSLATION.amplitude.to_si(self.displacement_mm))  # m
         angle = float(ROTATION.amplitude.to_si(self.angle_rad))  # rad
@@ -77,7 +77,7 @@ class CardView(PlotView):
             self.table.object = f"_The card is not available for this design: {exc}_"
             return
         try:
-            shown_reference = None if reference is None else card_sweeps(card_basis(reference), f)
+            shown_reference = None if reference is None else card_sweeps(reference, f)
         except ValueError:  # a reference with no card: the design's card alone
             shown_reference = None
         tolerances = band_tolerances(**self.state.band_inputs(), fit_result=self.fit.fit_result)

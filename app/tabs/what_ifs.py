@@ -22,7 +22,7 @@ from ..inputs import FIELD_ERROR_STYLES, field_error_html
 from ..live import LivePlot, one_change
 from ..number_field import NumberField
 from ..plotting.what_ifs import sensitivity_bars
-from ..shapes import card_basis, shape_pane
+from ..shapes import shape_pane
 from ..state import ExplorerState
 from ..targets_form import TargetsForm
 from ..views import PlotView
@@ -160,7 +160,7 @@ class WhatIfView(PlotView):
         _, reason = banded(tolerances, lambda tol: curves.operating_bands(design, f, x, s.freq_range, tol))
         if not reason:
             try:
-                _, reason = banded(tolerances, lambda tol: curves.card_bands(card_basis(design), f, tol))
+                _, reason = banded(tolerances, lambda tol: curves.card_bands(design, f, tol))
             except ValueError:  # no card for this design: its tab says so
                 pass
         if s.band_on and reason:
