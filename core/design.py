@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any
 
 from .effects import EFFECTS, validate_effects
-from .parameters import BY_NAME, DEFAULT_SHAPE, FILE_SHAPE, MODES, SHAPES, no_long_form
+from .parameters import BY_NAME, DEFAULT_SHAPE, MODES, SHAPES, file_shape, no_long_form
 from .parts import Geometry, Material, as_dict
 from .rules import (
     BAD_CHOICE,
@@ -281,7 +281,7 @@ class Design:
             out["name"] = self.name
         out["mode"] = self.mode
         if self.shape is not None:
-            out["shape"] = FILE_SHAPE[self.shape]
+            out["shape"] = file_shape(self.mode, self.shape)
         out["geometry"] = as_dict(self.geometry)
         out["material"] = as_dict(self.material)
         if self.effects:

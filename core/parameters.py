@@ -202,10 +202,24 @@ MODE_TABLE: tuple[Mode, ...] = (
 MODE = {m.name: m for m in MODE_TABLE}
 MODES = tuple(MODE)
 SHAPES = ("long", "finite")  # closed forms of long bushings, or the finite-length table
-# the design file's words for them (docs/files.md): "thesis" names the long-bushing closed forms
-# (the thesis' eqs 17 and 18); "long", this project's earlier word, is read as the same
+# the design file's words for them (docs/files.md): "thesis" names the thesis' closed forms, axial
+# (eq 18) and torsion (eq 17) only; "long", this project's earlier word for every long-bushing
+# closed form, is read as well and written for the plane-strain radial one, no formula of the thesis
 FILE_SHAPE = {"long": "thesis", "finite": "finite"}
 SHAPE_FROM_FILE = {"thesis": "long", "long": "long", "finite": "finite"}
+
+
+def file_shape(mode_name: str, shape: str) -> str:
+    """The design file's word for the shape ``shape`` (:data:`SHAPES`) in mode ``mode_name``."""
+    return "long" if shape == "long" and MODE[mode_name].long_equation is None else FILE_SHAPE[shape]
+
+
+def thesis_shape_refused(mode_name: str) -> str | None:
+    """Why a design file's shape ``thesis`` does not go with ``mode_name`` (its rule's words), or
+    None where the thesis has a closed form in that mode."""
+    if mode_name not in MODE or MODE[mode_name].long_equation is not None:
+        return None
+    return f"{mode_name}: the thesis' closed forms are axial (eq 18) and torsion (eq 17); use shape 'finite'"
 DEFAULT_SHAPE = {m.name: m.default_shape for m in MODE_TABLE}
 TRANSLATIONS = tuple(m.name for m in MODE_TABLE if not m.rotation)  # amplitude in m, stiffness in N/m
 ROTATIONS = tuple(m.name for m in MODE_TABLE if m.rotation)  # amplitude in rad, stiffness in N·m/rad

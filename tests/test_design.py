@@ -230,7 +230,9 @@ def test_the_shape_words_of_the_design_file():
     """The design file's ``shape`` is ``thesis`` or ``finite`` (docs/files.md): ``thesis`` gives the
     long-bushing closed forms, eq 18 axially (2πL / ln(b/a), computed here), and is what a file is
     written with; ``long``, the word earlier versions wrote, reads as the same design; anything
-    else, or ``thesis`` for the conical direction, is refused by its key."""
+    else, or ``thesis`` across the axis (radial, conical: no closed form of the thesis, as
+    docs/files.md says), is refused by its key; a radial ``long`` (the plane-strain closed form)
+    is read and written as such."""
     from core.io.design_file import design_from_dict
 
     a, b, length = (PAPER_B.geometry.inner_radius, PAPER_B.geometry.outer_radius, PAPER_B.geometry.length)
@@ -251,8 +253,15 @@ def test_the_shape_words_of_the_design_file():
         with pytest.raises(DesignError, match=rule) as caught:
             design_from_dict(data)
         assert caught.value.key == "shape"
-    conical = paper_b_dict()
-    conical.update(mode="conical", shape="thesis")
-    with pytest.raises(DesignError, match="no closed form") as caught:
-        design_from_dict(conical)
-    assert caught.value.key == "shape"
+    for mode in ("radial", "conical"):  # the thesis has no closed form across the axis
+        data = paper_b_dict()
+        data.update(mode=mode, shape="thesis")
+        with pytest.raises(DesignError, match=f"{mode}: the thesis' closed forms are axial .eq 18. and torsion .eq 17.; "
+                                              "use shape 'finite'") as caught:
+            design_from_dict(data)
+        assert caught.value.key == "shape"
+    # the plane-strain radial closed form, no formula of the thesis, keeps this project's word
+    radial = paper_b_dict()
+    radial.update(mode="radial", shape="long")
+    design = design_from_dict(radial)
+    assert design.shape_kind == "long" and json.loads(dumps_design(design))["shape"] == "long"

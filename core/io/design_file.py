@@ -12,7 +12,15 @@ from pathlib import Path
 from typing import Any
 
 from ..design import Design
-from ..parameters import FILE_SHAPE, GEOMETRY, MATERIAL, MODES, OPTIONAL, SHAPE_FROM_FILE
+from ..parameters import (
+    FILE_SHAPE,
+    GEOMETRY,
+    MATERIAL,
+    MODES,
+    OPTIONAL,
+    SHAPE_FROM_FILE,
+    thesis_shape_refused,
+)
 from ..parts import Geometry, Material, check_bulk_ratio
 from ..rules import (
     BAD_CHOICE,
@@ -68,6 +76,8 @@ def design_from_dict(data: Any) -> Design:
     shape = data.get("shape")
     if shape is not None and (not isinstance(shape, str) or shape not in SHAPE_FROM_FILE):
         raise DesignError("shape", f"must be one of {', '.join(FILE_SHAPE.values())}, got {shape!r}", BAD_CHOICE)
+    if shape == "thesis" and thesis_shape_refused(data["mode"]):
+        raise DesignError("shape", thesis_shape_refused(data["mode"]), BAD_CHOICE)
     material = Material(**data["material"])
     check_bulk_ratio(material)
     return Design(
