@@ -165,17 +165,18 @@ class Diagnosis:
         return replace(self, data=self.data.of_mode(mode), baseline=part(self.baseline), final=part(self.final))
 
     def predictions(self) -> dict[str, np.ndarray]:
-        """Per data row: the baseline's and the final model's |K| and loss factor (and the
-        row's mode first, for data with a `mode` column)."""
+        """Per data row: the baseline's and the final model's |K| and loss factor, the six
+        columns of docs/files.md in their order (and the row's mode last, for data with a `mode`
+        column, so that a reader by position finds the six where they always are)."""
         kb, kf = self.baseline.stiffness, self.final.stiffness
         return {
-            **({} if self.data.mode is None else {"mode": self.data.mode}),
             "frequency_hz": self.data.frequency_hz,
             "amplitude": self.data.amplitude,
             "baseline_magnitude": np.abs(kb),
             "baseline_loss_factor": loss_factor(kb),
             "final_magnitude": np.abs(kf),
             "final_loss_factor": loss_factor(kf),
+            **({} if self.data.mode is None else {"mode": self.data.mode}),
         }
 
 
