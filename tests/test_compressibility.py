@@ -252,6 +252,13 @@ def test_the_command_line_fits_the_bulk_modulus_when_asked(tmp_path, capsys):
     assert main(["fit", str(tmp_path / "ar.csv"), "--design", str(tmp_path / "thin.json")]) in (0, None)
     known = json.loads(capsys.readouterr().out)
     assert "bulk_modulus" not in known["material"] and "bulk_modulus" not in known["fit"]["standard_errors"]
+    # K given and held known: the standard errors still have the keys of `material` (FORMATS), K's 0
+    write_design(THIN.replace(shear_modulus=2e6, bulk_modulus=1.5e9), tmp_path / "thin_k.json")
+    assert main(["fit", str(tmp_path / "ar.csv"), "--design", str(tmp_path / "thin_k.json")]) in (0, None)
+    held = json.loads(capsys.readouterr().out)
+    assert list(held["fit"]["standard_errors"]) == list(held["material"])
+    assert held["fit"]["standard_errors"]["bulk_modulus"] == 0.0 and held["material"]["bulk_modulus"] == 1.5e9
+    assert all(held["fit"]["standard_errors"][k] > 0 for k in MATERIAL)
 
 
 def test_the_loop_puts_the_bulk_spring_in_series_and_the_explorer_draws_it():

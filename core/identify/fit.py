@@ -120,13 +120,18 @@ class FitResult:
     def report(self) -> dict:
         """The ``fit`` object of the fitted design file (docs/files.md). A number the data do
         not define (a standard error or correlation of a degenerate fit, the standard error of
-        an undetermined parameter) is null."""
+        an undetermined parameter) is null. The standard errors have the keys of the design's
+        ``material`` (in its order), a parameter held known (the bulk modulus, unless freed)
+        at 0, then those of any other fitted parameter."""
         def finite(v):
             return float(v) if v is not None and math.isfinite(v) else None
 
         vague = set(self.undetermined)
+        errors = {k: None if k in vague else finite(v) for k, v in self.standard_errors.items()}
+        material = as_dict(self.design.material)
         out = {
-            "standard_errors": {k: None if k in vague else finite(v) for k, v in self.standard_errors.items()},
+            "standard_errors": {**{k: errors.get(k, 0.0) for k in material},
+                                **{k: v for k, v in errors.items() if k not in material}},
             "correlation": {a: {b: finite(v) for b, v in row.items()} for a, row in self.correlation.items()},
             "gap": finite(self.gap),
             "points": self.points,
