@@ -28,6 +28,7 @@ from .parameters import BRANCH_PARAMETERS, BY_NAME, MODE, MODES, TRANSLATIONS, P
 from .parts import Material
 from .rules import BAD_CHOICE, BAD_TYPE, MISSING_KEY, NEGATIVE, UNKNOWN_KEY, DesignError
 from .rules import number as _number
+from .shape import long_shape_factor
 
 
 def _branch(branch: str) -> tuple[Parameter, ...]:
@@ -287,12 +288,24 @@ def wave_stiffness(mode: str, inner_radius, outer_radius, length, modulus, frequ
     w = A J0(kr) + B Y0(kr) and K = 2π a L µ_eq w'(a) / d.
     Torsion: v = rθ, v'' + v'/r − v/r² + k² v = 0, v(a) = 0, v(b) = bφ, so
     v = A J1(kr) + B Y1(kr) and K = 2π a² L µ_eq v'(a) / φ (τ = µ_eq (v' − v/r) at r = a).
-    Tends to eqs 17/18 as ρω²/µ → 0. Broadcast over ``modulus`` and ``frequency_hz``.
+    Tends to eqs 17/18 as ρω²/µ → 0, and is that limit where |kb| < 1e-6 (ρ = 0 included: its
+    Bessel functions of the second kind diverge at 0; the rest is O((kb)²) below 1e-12).
+    Broadcast over ``modulus`` and ``frequency_hz``.
     """
     a, b, L = inner_radius, outer_radius, length
     mu = np.asarray(modulus, dtype=complex)
     omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
     k = omega * np.sqrt(density / mu)
+    static = np.abs(k * b) < 1e-6
+    if np.any(static):
+        with np.errstate(all="ignore"):
+            waves = _standing_waves(mode, a, b, L, mu, np.where(static, 1.0 / b, k))
+        return np.where(static, long_shape_factor(a, b, L, mode) * mu, waves)
+    return _standing_waves(mode, a, b, L, mu, k)
+
+
+def _standing_waves(mode: str, a, b, L, mu, k):
+    """:func:`wave_stiffness`'s Bessel solution at wavenumber ``k`` (complex, nonzero)."""
     ka, kb = k * a, k * b
     if mode == "axial":
         # A J0(ka) + B Y0(ka) = 0, A J0(kb) + B Y0(kb) = 1 (unit drive)

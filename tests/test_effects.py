@@ -137,3 +137,26 @@ def test_loop_with_material_effects_matches_its_stiffness():
     lp = loop(design, f, x, 1024)
     c = 2 * np.mean(lp.force * np.sin(lp.phase)) + 2j * np.mean(lp.force * np.cos(lp.phase))
     assert_allclose(c / x, stiffness(design, f, x).stiffness[0, 0], rtol=1e-9)
+
+
+@pytest.mark.parametrize("mode", ["axial", "torsion"])
+def test_standing_waves_without_density_are_the_static_closed_form(mode):
+    """ρ = 0 (no rubber inertia) is eq 18 / eq 17 times µ_eq exactly (the Bessel solution's
+    second-kind functions diverge at k = 0; a file may give ρ = 0), and the limit joins the wave
+    solution continuously: at kb just above its switch (1e-6) the two differ by O((kb)²)."""
+    from core.effects import wave_stiffness
+    from core.shape import long_shape_factor
+
+    a, b, length = 0.02, 0.035, 0.09
+    mu = np.array([2.4e6 + 3.1e5j, 5.0e6 + 1.0e6j])
+    f = np.array([10.0, 1000.0])
+    got = wave_stiffness(mode, a, b, length, mu, f, 0.0)
+    assert np.all(np.isfinite(got))
+    np.testing.assert_allclose(got, long_shape_factor(a, b, length, mode) * mu, rtol=1e-15)
+    # densities putting |kb| on either side of the switch, at 10 Hz and µ* = mu[0]
+    k_per_sqrt_rho = 2 * np.pi * 10.0 / np.sqrt(mu[0])
+    for kb in (0.9e-6, 1.1e-6, 1e-3):
+        rho = float((kb / (b * abs(k_per_sqrt_rho))) ** 2)
+        k = wave_stiffness(mode, a, b, length, mu[0], 10.0, rho)
+        static = long_shape_factor(a, b, length, mode) * mu[0]
+        assert abs(k / static - 1) < max(kb**2, 1e-9)
