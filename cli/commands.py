@@ -35,14 +35,14 @@ from .parser import (  # the command line's words and bounds
     NUMBER_FORMAT,
     InputError,
     _count,
-    _positive,
+    _frequency,
     build_parser,
 )
 
 
 def _frequencies(args) -> np.ndarray:
-    f1 = _positive("--freq F1")(args.freq[0])
-    f2 = _positive("--freq F2")(args.freq[1])
+    f1 = _frequency("--freq F1")(args.freq[0])
+    f2 = _frequency("--freq F2")(args.freq[1])
     n = _count("--freq N", 1, MAX_FREQUENCIES)(args.freq[2])
     if n == 1 and f1 != f2:
         raise InputError("bushing stiffness: --freq with N = 1 needs F1 = F2")

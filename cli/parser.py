@@ -52,6 +52,24 @@ def _positive(name):
     return parse
 
 
+def _frequency(name):
+    """A positive number of Hz within the frequencies a measured file may hold
+    (:data:`core.io.measured.MEASURED_FREQUENCY_HZ`): the range the model is meant for."""
+    from core.io.measured import MEASURED_FREQUENCY_HZ
+
+    positive = _positive(name)
+
+    def parse(text: str) -> float:
+        value = positive(text)
+        lo, hi = MEASURED_FREQUENCY_HZ
+        if not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"{name} must be within {lo:g}–{hi:g} Hz (a rubber bushing's "
+                                             f"frequencies, as measured files hold), got {text[:40]!r}")
+        return value
+
+    return parse
+
+
 def _count(name, minimum=1, maximum=None):
     def parse(text: str) -> int:
         if not WHOLE.fullmatch(str(text).strip()):
@@ -61,6 +79,24 @@ def _count(name, minimum=1, maximum=None):
             raise argparse.ArgumentTypeError(f"{name} must be at least {minimum}, got {text!r}")
         if maximum is not None and value > maximum:
             raise argparse.ArgumentTypeError(f"{name} must be at most {maximum}, got {text!r}")
+        return value
+
+    return parse
+
+
+def _frequency(name):
+    """A positive number of Hz within the frequencies a measured file may hold
+    (:data:`core.io.measured.MEASURED_FREQUENCY_HZ`): the range the model is meant for."""
+    from core.io.measured import MEASURED_FREQUENCY_HZ
+
+    positive = _positive(name)
+
+    def parse(text: str) -> float:
+        value = positive(text)
+        lo, hi = MEASURED_FREQUENCY_HZ
+        if not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"{name} must be within {lo:g}–{hi:g} Hz (a rubber bushing's "
+                                             f"frequencies, as measured files hold), got {text[:40]!r}")
         return value
 
     return parse
@@ -118,7 +154,7 @@ def build_parser() -> argparse.ArgumentParser:
         "force_friction (m or rad; N or N·m).",
     )
     lp.add_argument("design", metavar="DESIGN.json", help="design file (docs/files.md)")
-    lp.add_argument("--freq", required=True, type=_positive("--freq"), metavar="F", help="Hz")
+    lp.add_argument("--freq", required=True, type=_frequency("--freq"), metavar="F", help="Hz")
     lp.add_argument(
         "--amp", required=True, type=_positive("--amp"), metavar="A", help="peak, m or rad"
     )
@@ -169,13 +205,13 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"every direction at one operating point: {', '.join(TRANSLATIONS + ROTATIONS)} (CSV)",
         description="The bushing card: the dynamic stiffness in the four directions at one "
         f"frequency, {' and '.join(TRANSLATIONS)} at D {CARD_DISPLACEMENT.display}, {' and '.join(ROTATIONS)} "
-        "at R rad, with finite-length "
-        "shape factors (the design's shape 'thesis' keeps the closed forms for axial and torsion). "
+        "at R rad, each with the design file's shape factor: the closed forms for axial and torsion "
+        "unless the design's shape is 'finite', the finite-length table for radial and conical. "
         "Writes CSV with columns mode, amplitude (m or rad), stiffness_real, stiffness_imag, "
         "magnitude, loss_factor, shape_factor.",
     )
     cd.add_argument("design", metavar="DESIGN.json", help="design file (docs/files.md); its mode is not used")
-    cd.add_argument("--freq", required=True, type=_positive("--freq"), metavar="F", help="Hz")
+    cd.add_argument("--freq", required=True, type=_frequency("--freq"), metavar="F", help="Hz")
     cd.add_argument("--amp-mm", required=True, type=_positive("--amp-mm"), metavar="D",
                     help=f"peak displacement of the {' and '.join(TRANSLATIONS)} directions, "
                     f"{CARD_DISPLACEMENT.display}")
