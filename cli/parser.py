@@ -84,24 +84,6 @@ def _count(name, minimum=1, maximum=None):
     return parse
 
 
-def _frequency(name):
-    """A positive number of Hz within the frequencies a measured file may hold
-    (:data:`core.io.measured.MEASURED_FREQUENCY_HZ`): the range the model is meant for."""
-    from core.io.measured import MEASURED_FREQUENCY_HZ
-
-    positive = _positive(name)
-
-    def parse(text: str) -> float:
-        value = positive(text)
-        lo, hi = MEASURED_FREQUENCY_HZ
-        if not lo <= value <= hi:
-            raise argparse.ArgumentTypeError(f"{name} must be within {lo:g}–{hi:g} Hz (a rubber bushing's "
-                                             f"frequencies, as measured files hold), got {text[:40]!r}")
-        return value
-
-    return parse
-
-
 def subcommands(parser: argparse.ArgumentParser):
     """The sub-parser action of :func:`build_parser`'s parser (to add commands to)."""
     return next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
