@@ -2,34 +2,24 @@
 and headers, a column named twice, several files at once, a loop recorded in ms. Every refusal
 is one short line naming the file, the line and the rule."""
 
-import json
 from pathlib import Path
 
-import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from cli.commands import main
 from core import PAPER_B
 from core.data import DataError
 from core.io.measured import parse_loop, parse_stiffness, read_loop, read_stiffness
 from core.numbers import format_outside
 from core.rules import EXCERPT_CHARS, excerpt
 from core.synthetic import synthetic_loop
+from tests.helpers import run
 
 HEAD = "frequency_hz,amplitude,magnitude,loss_factor\n"
 GOOD = HEAD + "10,1e-4,4.2e6,0.138\n20,1e-4,4.3e6,0.14\n"
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 # a message quoting a file's value: the excerpt and the words around it, never the value whole
 SHORT = 400
-
-
-def run(argv, capsys):
-    try:
-        status = main([str(a) for a in argv])
-    except SystemExit as exc:
-        status = exc.code
-    return (status, *capsys.readouterr())
 
 
 def refusal(parse, text) -> DataError:
