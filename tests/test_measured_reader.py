@@ -1,15 +1,17 @@
-"""The measured-data reader against files as they come: blank lines at the end, huge fields
-and headers, a column named twice, several files at once, a loop recorded in ms. Every refusal
-is one short line naming the file, the line and the rule."""
+"""The measured-data reader against files as they come: the product's own stiffness CSV fed back,
+blank lines at the end, huge fields and headers, a column named twice, several files at once,
+a loop recorded in ms. Every refusal is one short line naming the file, the line and the rule."""
 
+import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
 from core import PAPER_B
 from core.data import DataError
-from core.io.measured import parse_loop, parse_stiffness, read_loop, read_stiffness
+from core.io.measured import FORMS_AGREE, parse_loop, parse_stiffness, read_loop, read_stiffness
 from core.numbers import format_outside
 from core.rules import EXCERPT_CHARS, excerpt
 from core.synthetic import synthetic_loop
@@ -26,6 +28,79 @@ def refusal(parse, text) -> DataError:
     with pytest.raises(DataError) as info:
         parse(text)
     return info.value
+
+
+# ---- 1. both forms of the stiffness, as `bushing stiffness` writes them ---------------------------
+
+
+def test_the_stiffness_csv_of_the_command_line_is_fitted_back_to_its_material(tmp_path, capsys):
+    data, fitted = tmp_path / "d.csv", tmp_path / "fitted.json"
+    status, _, err = run(["stiffness", EXAMPLES / "paper_b_true.json", "--freq", 1, 100, 10,
+                          "--amp", 1e-5, 1e-4, 1e-3, "-o", data], capsys)
+    assert status == 0 and err == ""
+    assert data.read_text().splitlines()[0] == ("frequency_hz,amplitude,stiffness_real,stiffness_imag,"
+                                                "magnitude,loss_factor")
+    status, _, err = run(["fit", data, "--design", EXAMPLES / "paper_b_guess.json", "-o", fitted], capsys)
+    assert status == 0, err
+    truth = json.loads((EXAMPLES / "paper_b_true.json").read_text())["material"]
+    found = json.loads(fitted.read_text())
+    assert found["fit"]["gap"] < 1e-8  # noise-free data of the model itself
+    for key, value in truth.items():
+        assert found["material"][key] == pytest.approx(value, rel=1e-6), key
+
+
+def test_both_forms_are_read_as_the_cartesian_one_where_re_k_is_negative():
+    """The loss-factor form cannot say Re K < 0; `bushing stiffness` writes η = Im K / Re K with
+    its sign beside the parts, and the two agree: K is the parts'."""
+    k = np.array([4e6 + 5e5j, -2e6 + 1e5j, -3e6 - 2e4j])
+    rows = "".join(f"{10 * (i + 1)},1e-4,{z.real:.12g},{z.imag:.12g},{abs(z):.12g},{z.imag / z.real:.12g}\n"
+                   for i, z in enumerate(k))
+    data = parse_stiffness("frequency_hz,amplitude,stiffness_real,stiffness_imag,magnitude,loss_factor\n" + rows)
+    assert_allclose(data.stiffness, k, rtol=1e-12)
+
+
+@pytest.mark.parametrize("columns", [
+    ("stiffness_real", "stiffness_imag", "magnitude", "phase_deg"),
+    ("magnitude", "loss_factor", "phase_deg"),
+    ("stiffness_real", "stiffness_imag", "magnitude", "loss_factor", "phase_deg"),
+])
+def test_any_forms_that_agree_are_read_together(columns):
+    k = np.array([4e6 + 5e5j, 3e6 - 2e4j, -2e6 + 1e5j, -1e6 - 1e5j, -3e6 + 0j])
+    if "stiffness_real" not in columns:  # magnitude, loss factor and phase: Re K > 0 only
+        k = k[:2]
+    value = {"stiffness_real": k.real, "stiffness_imag": k.imag, "magnitude": np.abs(k),
+             "loss_factor": k.imag / k.real, "phase_deg": np.rad2deg(np.angle(k))}
+    text = "frequency_hz,amplitude," + ",".join(columns) + "\n" + "".join(
+        f"{10 * (i + 1)},1e-4," + ",".join(f"{value[c][i]:.12g}" for c in columns) + "\n" for i in range(k.size))
+    assert_allclose(parse_stiffness(text).stiffness, k, rtol=1e-11)
+
+
+@pytest.mark.parametrize("column, value, words", [
+    ("magnitude", "4.3e6", "magnitude is 4300000 but |stiffness_real + i stiffness_imag| is 4200000"),
+    ("loss_factor", "0.139", "loss_factor is 0.139 but stiffness_imag/stiffness_real is 0.138"),
+])
+def test_two_forms_that_disagree_are_refused_naming_the_line_and_both_values(column, value, words):
+    re = 4.2e6 / np.hypot(1, 0.138)
+    rows = [[10, 1e-4, f"{re:.12g}", f"{0.138 * re:.12g}", "4.2e6", "0.138"] for _ in range(3)]
+    rows[1][{"magnitude": 4, "loss_factor": 5}[column]] = value
+    text = "frequency_hz,amplitude,stiffness_real,stiffness_imag,magnitude,loss_factor\n" + "".join(
+        ",".join(map(str, r)) + "\n" for r in rows)
+    err = refusal(parse_stiffness, text)
+    assert (err.key, err.code) == ("line 3", "conflict") and words in err.rule, str(err)
+    # agreement within FORMS_AGREE: a last digit of 12 is no disagreement, 1e-8 relative is
+    rows[1][4 if column == "magnitude" else 5] = f"{(4.2e6 if column == 'magnitude' else 0.138) * (1 + 1e-11):.12g}"
+    assert len(parse_stiffness(text.split("\n", 1)[0] + "\n" + "".join(",".join(map(str, r)) + "\n" for r in rows)))
+    assert FORMS_AGREE == 1e-9
+
+
+def test_a_file_whose_forms_disagree_is_refused_by_the_command_line_naming_file_and_line(tmp_path, capsys):
+    measured = tmp_path / "edited.csv"
+    size = f"{np.hypot(4e6, 4e5):.12g}"  # |K| of the parts, to the 12 digits written
+    measured.write_text("frequency_hz,amplitude,stiffness_real,stiffness_imag,magnitude,loss_factor\n"
+                        f"10,1e-4,4000000,400000,{size},0.1\n20,1e-4,4000000,400000,4100000,0.1\n")
+    status, out, err = run(["fit", measured, "--design", EXAMPLES / "paper_b_true.json"], capsys)
+    assert status == 2 and out == "" and err.count("\n") == 1
+    assert "line 3: the two forms of the stiffness disagree" in err and "(in edited.csv)" in err
 
 
 # ---- 2. blank lines at the end ------------------------------------------------------------------

@@ -20,6 +20,7 @@ import numpy as np
 from ..data import STIFFNESS_RANGE, DataError, MeasuredLoop, MeasuredStiffness
 from ..numbers import format_number, format_outside
 from ..parameters import MODES
+from ..response import loss_factor
 from ..rules import (
     BAD_CHOICE,
     BAD_SIGNAL,
@@ -55,6 +56,13 @@ LOOP_SINE_DEPARTURE = 0.1
 STIFFNESS_KEYS = ("frequency_hz", "amplitude")
 # the three forms of complex stiffness a file may give; only the last two carry the sign of Re K
 STIFFNESS_PAIRS = (("magnitude", "loss_factor"), ("stiffness_real", "stiffness_imag"), ("magnitude", "phase_deg"))
+# several forms in one file: K is read from the one that says most (the Cartesian, then the
+# phase: both carry the sign of Re K), the others must agree with it within FORMS_AGREE
+# (relative in |K| and K, absolute and relative in the loss factor). ``bushing stiffness`` writes
+# 12 significant digits, each value within 5e-13 of its own: forms written with 10 digits or
+# more agree to about 1e-10, while an edited or shifted column differs by far more
+FORM_ORDER = (STIFFNESS_PAIRS[1], STIFFNESS_PAIRS[2], STIFFNESS_PAIRS[0])
+FORMS_AGREE = 1e-9
 PHASE_DEG = (-180.0, 180.0)  # the phase of K = |K| e^{iφ} in degrees, as test rigs write it
 LOOP_COLUMNS = tuple(f.name for f in fields(MeasuredLoop))  # time_s, displacement, force
 
@@ -191,22 +199,23 @@ def _named(path: Path, parse, text: str):
 
 
 def parse_stiffness(text: str | bytes) -> MeasuredStiffness:
-    """Parse a measured-stiffness CSV: columns frequency_hz, amplitude and one form of the complex
-    stiffness (:data:`STIFFNESS_PAIRS`: magnitude + loss_factor, stiffness_real + stiffness_imag
-    or magnitude + phase_deg); one row per point. Any finite, non-zero complex K is accepted."""
+    """Parse a measured-stiffness CSV: columns frequency_hz, amplitude and one or more forms of
+    the complex stiffness (:data:`STIFFNESS_PAIRS`: magnitude + loss_factor, stiffness_real +
+    stiffness_imag or magnitude + phase_deg); one row per point. Any finite, non-zero complex K
+    is accepted. Forms given together (the CSV of ``bushing stiffness`` gives the first two)
+    must agree within :data:`FORMS_AGREE`; K is read from the one that says most (the
+    Cartesian, then the phase, then the loss factor: only the first two carry the sign of
+    Re K)."""
     df = _table(text, "stiffness")
     cols = set(df.columns)
-    pairs = [p for p in STIFFNESS_PAIRS if set(p) <= cols]
+    pairs = sorted((p for p in STIFFNESS_PAIRS if set(p) <= cols), key=FORM_ORDER.index)
     missing = [c for c in STIFFNESS_KEYS if c not in cols]
     if missing or not pairs:
         need = " or ".join(" + ".join(p) for p in STIFFNESS_PAIRS)
         raise DataError("line 1", f"the header must name frequency_hz, amplitude and either {need}"
                         f" (found: {_columns(df.columns)})", MISSING_KEY)
-    if len(pairs) > 1:  # loss_factor beside phase_deg, or both polar and Cartesian: which one holds?
-        raise DataError("line 1", f"give one form of the stiffness, not {' and '.join(' + '.join(p) for p in pairs)}",
-                        CONFLICT)
-    pair = pairs[0]
-    extra = cols - set(STIFFNESS_KEYS) - set(pair) - {"mode"}
+    given = {c for p in pairs for c in p}
+    extra = cols - set(STIFFNESS_KEYS) - given - {"mode"}
     if extra:
         raise DataError("line 1", f"unknown column(s) {_columns(sorted(extra))}", UNKNOWN_KEY)
     _rows(df, "stiffness")
@@ -217,7 +226,7 @@ def parse_stiffness(text: str | bytes) -> MeasuredStiffness:
         if bad:
             raise DataError(f"line {df.line(bad[0])}", f"mode must be one of {', '.join(MODES)}, got "
                             f"{excerpt(mode[bad[0]])!r}", BAD_CHOICE)
-    v = _numbers(df, (*STIFFNESS_KEYS, *pair))
+    v = _numbers(df, (*STIFFNESS_KEYS, *sorted(given, key=list(df.columns).index)))
     _positive(df, v, "frequency_hz")
     _positive(df, v, "amplitude")
     lo, hi = MEASURED_FREQUENCY_HZ
@@ -225,7 +234,7 @@ def parse_stiffness(text: str | bytes) -> MeasuredStiffness:
     if outside.size:
         raise DataError(f"line {df.line(outside[0])}", f"frequency_hz must be within {lo:g}–{hi:g} Hz, got "
                         f"{format_outside(v['frequency_hz'][outside[0]], lo, hi)}", OUT_OF_RANGE)
-    k = _complex_stiffness(df, v, pair)
+    k = _complex_stiffness(df, v, pairs[0])
     # any finite complex stiffness is a possible measurement: Im K < 0 (a negative loss factor)
     # is a blocked transfer stiffness above a wave resonance, Re K < 0 a mass-dominated one
     with np.errstate(over="ignore"):
@@ -239,6 +248,8 @@ def parse_stiffness(text: str | bytes) -> MeasuredStiffness:
         raise DataError(f"line {df.line(bad[0])}", f"the stiffness magnitude |K| = "
                         f"{format_outside(size[bad[0]], lo, hi)} must be within {lo:g}–{hi:g} N/m or N·m/rad; "
                         "are the units right?", OUT_OF_RANGE)
+    for other in pairs[1:]:
+        _agree(df, v, k, pairs[0], other)
     return MeasuredStiffness(v["frequency_hz"], v["amplitude"], k, None, mode)
 
 
@@ -258,6 +269,34 @@ def _complex_stiffness(df: _Table, v: dict[str, np.ndarray], pair: tuple[str, st
         raise DataError(f"line {df.line(bad[0])}", f"phase_deg must be within {lo:g}…{hi:g} degrees, got "
                         f"{format_outside(phase[bad[0]], lo, hi)}", OUT_OF_RANGE)
     return v["magnitude"] * np.exp(1j * np.deg2rad(phase))
+
+
+def _agree(df: _Table, v: dict[str, np.ndarray], k: np.ndarray, base: tuple[str, str], other: tuple[str, str]):
+    """A second form of the stiffness, ``other``, says the K read from ``base``: its |K| within
+    :data:`FORMS_AGREE` relative, its loss factor within that absolute and relative (the
+    loss-factor form, whatever the sign of Re K, as ``bushing stiffness`` writes it), or its
+    K within that relative (the phase form); else the first row that disagrees is refused."""
+    cartesian = base[0] == "stiffness_real"
+    said = "|stiffness_real + i stiffness_imag|" if cartesian else "magnitude"
+    checks = [("magnitude", np.abs(k), said, FORMS_AGREE * np.abs(k))]
+    if other[1] == "loss_factor":
+        ratio = "stiffness_imag/stiffness_real" if cartesian else "tan(phase_deg)"
+        eta = loss_factor(k)
+        checks.append(("loss_factor", eta, ratio, FORMS_AGREE * (1.0 + np.abs(eta))))
+    else:  # the phase form beside the Cartesian: the angle of K
+        checks.append(("phase_deg", np.rad2deg(np.angle(k)), "the angle of stiffness_real + i stiffness_imag",
+                       np.rad2deg(FORMS_AGREE)))
+    for col, value, words, allowed in checks:
+        with np.errstate(invalid="ignore"):
+            off = ~(np.abs(v[col] - value) <= allowed)
+        if col == "phase_deg":  # −180 and 180 are one angle
+            off &= ~(np.abs(np.abs(v[col] - value) - 360.0) <= allowed)
+        bad = np.flatnonzero(off)
+        if bad.size:
+            i = bad[0]
+            raise DataError(f"line {df.line(i)}", f"the two forms of the stiffness disagree: {col} is "
+                            f"{v[col][i]:.12g} but {words} is {value[i]:.12g} (they must agree within "
+                            f"{FORMS_AGREE:g}); give one form, or both of the same K", CONFLICT)
 
 
 def combined(parts: list[MeasuredStiffness], default_mode: str) -> MeasuredStiffness:
