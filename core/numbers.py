@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 from decimal import Decimal
 
-from .rules import RuleError, decimal
+from .rules import RuleError, decimal, excerpt
 
 # significant digits by quantity (the words the callers use)
 DIGITS = {
@@ -80,6 +80,18 @@ def format_number(value, quantity: str | int | None = None) -> str:
     return f"{_positional(mantissa, digits)}×10{str(exponent).translate(_SUPERSCRIPT)}"
 
 
+def format_outside(value, low: float, high: float, quantity: str | int | None = None) -> str:
+    """:func:`format_number` of a value outside [``low``, ``high``], with as many more digits as
+    keep it outside: a message never says "0.0001 Hz must be within 0.0001–100000 Hz" of a
+    value just below its bound (a value inside is written as :func:`format_number` writes it)."""
+    digits = digits_of(quantity)
+    value = float(value)
+    if math.isfinite(value) and not low <= value <= high:
+        while digits < 17 and low <= rounded(value, digits) <= high:
+            digits += 1
+    return format_number(value, digits)
+
+
 def format_value(value, unit: str = "", quantity: str | int | None = None) -> str:
     """:func:`format_number` followed by ``unit`` (none for ``""`` or ``–``): ``35.73 kN/mm``."""
     text = format_number(value, quantity)
@@ -127,7 +139,7 @@ def parse_number(text, what: str = "") -> float:
     except RuleError as exc:
         if raw == "":
             raise RuleError(what, "is empty: enter a number", exc.code) from None
-        raise RuleError(what, f"“{raw[:40]}” is not a number", exc.code) from None
+        raise RuleError(what, f"“{excerpt(raw)}” is not a number", exc.code) from None
 
 
 def range_problem(value: float, low: float | None, high: float | None, unit: str = "",

@@ -87,6 +87,9 @@ CODES = (NOT_A_NUMBER, NOT_FINITE, OVERFLOW, NOT_POSITIVE, NEGATIVE, OUT_OF_RANG
 DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
 WHOLE = re.compile(r"[+-]?\d+", re.ASCII)  # a whole number's text: ASCII digits, as DECIMAL's
 _NOT_FINITE_WORDS = ("nan", "inf", "infinity")
+# the characters of an input's value a message quotes (a cell, a column name, a typed text):
+# enough to recognise it, never the megabytes a hostile file may hold
+EXCERPT_CHARS = 40
 
 
 class RuleError(ValueError):
@@ -157,6 +160,13 @@ class DesignError(RuleError):
     """
 
 
+def excerpt(value: Any, limit: int = EXCERPT_CHARS) -> str:
+    """An untrusted value as a message may quote it: its text, cut to ``limit`` characters and
+    ``…`` when longer, so that one message line stays short whatever the input holds."""
+    text = str(value)
+    return text if len(text) <= limit else text[:limit] + "…"
+
+
 # ---- numbers ----------------------------------------------------------------------------------
 
 
@@ -220,12 +230,12 @@ def decimal(text: str, key: str = "", error: type[RuleError] = RuleError) -> flo
     if text == "":
         raise error(key, "is missing", MISSING_KEY)
     if text.lower().lstrip("+-") in _NOT_FINITE_WORDS:
-        raise error(key, f"is not finite ({text!r})", NOT_FINITE)
+        raise error(key, f"is not finite ({excerpt(text)!r})", NOT_FINITE)
     if not DECIMAL.fullmatch(text):
-        raise error(key, f"is not a number ({text!r})", NOT_A_NUMBER)
+        raise error(key, f"is not a number ({excerpt(text)!r})", NOT_A_NUMBER)
     value = float(text)
     if not math.isfinite(value):
-        raise error(key, f"is too large for a number ({text!r})", OVERFLOW)
+        raise error(key, f"is too large for a number ({excerpt(text)!r})", OVERFLOW)
     return value
 
 

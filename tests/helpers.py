@@ -1,10 +1,22 @@
-"""Small helpers shared by tests that start a server."""
+"""Small helpers shared by tests: the command line run in process, a server started."""
 
 import asyncio
 import contextlib
 import queue
 import threading
 import urllib.request
+
+
+def run(argv, capsys):
+    """``bushing argv`` run in process: (exit status, standard output, standard error)."""
+    from cli.main import main  # the `bushing` entry point
+
+    try:
+        status = main([str(a) for a in argv])
+    except SystemExit as exc:
+        status = exc.code
+    out, err = capsys.readouterr()
+    return status, out, err
 
 
 def fetch(url: str, timeout: float = 60.0) -> bytes:

@@ -165,6 +165,15 @@ def _with_column(text: str, name: str, value: str) -> str:
     return "\n".join([f"{lines[0]},{name}", *(f"{line},{value}" for line in lines[1:])]) + "\n"
 
 
+def _both_forms() -> str:
+    """GOOD_ROWS as ``bushing stiffness`` writes them: both forms of each K, 12 digits."""
+    rows = []
+    for f, x, m, eta in GOOD_ROWS:
+        re = m / math.hypot(1.0, eta)
+        rows.append(f"{f},{x},{re:.12g},{eta * re:.12g},{m},{eta}\n")
+    return "frequency_hz,amplitude,stiffness_real,stiffness_imag,magnitude,loss_factor\n" + "".join(rows)
+
+
 def _cell_rule(column: str, value) -> tuple[str, ...] | None:
     """The refusal words of a cell of line 6 read as ``value`` (BAD_CELLS), or None: valid (any
     finite complex K with |K| > 0, Re K < 0 and Im K < 0 too)."""
@@ -214,8 +223,10 @@ def measured_cases(folder: Path, files: dict, design: Path) -> list[Case]:
         "210 000 rows": (header + point * 210_000, ("too many rows",)),
         "real and imaginary, zero": ("frequency_hz,amplitude,stiffness_real,stiffness_imag\n" + "10,1e-4,0,0\n" * 3,
                                      ("line 2", "zero")),
-        "both column pairs": (_with_column(measured_text(), "stiffness_real,stiffness_imag", "1,1"),
-                              ("line 1", "one form")),
+        "both column pairs, disagreeing": (_with_column(measured_text(), "stiffness_real,stiffness_imag", "1,1"),
+                                           ("line 2", "disagree", "magnitude")),
+        # the CSV of `bushing stiffness` gives both forms, of the same K: read back as it is
+        "both column pairs, as bushing stiffness writes them": (_both_forms(), ("fit",)),
         # a blocked transfer stiffness above a wave resonance: Im K < 0 is measured, and valid
         "a negative loss factor above a wave resonance": (measured_text(extra="800,0.008,7950.23,-0.0075\n"),
                                                           ("fit", "diagnose")),
@@ -227,7 +238,8 @@ def measured_cases(folder: Path, files: dict, design: Path) -> list[Case]:
                               ("line 11", "phase_deg", "180")),
         "a phase column without its unit": (measured_text("phase").replace("phase_deg", "phase"),
                                             ("line 1", "phase_deg")),
-        "loss factor and phase both": (_with_column(measured_text(), "phase_deg", "7.9"), ("line 1", "one form")),
+        "loss factor and phase both, disagreeing": (_with_column(measured_text(), "phase_deg", "7.9"),
+                                                    ("line 2", "disagree", "loss_factor")),
     })
     cases = []
     for i, (name, (text, rule)) in enumerate(texts.items()):

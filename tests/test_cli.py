@@ -13,9 +13,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from cli.main import main  # the `bushing` entry point
 from core import PAPER_B, TABLE_1, loop, stiffness, write_design
-from tests.helpers import fetch
+from tests.helpers import fetch, run
 
 STIFFNESS_COLUMNS = ["frequency_hz", "amplitude", "stiffness_real", "stiffness_imag", "magnitude",
                      "loss_factor"]
@@ -29,15 +28,6 @@ def designs(tmp_path):
         paths[key] = tmp_path / f"{key}.json"
         write_design(design, paths[key])
     return paths
-
-
-def run(argv, capsys):
-    try:
-        status = main([str(a) for a in argv])
-    except SystemExit as exc:
-        status = exc.code
-    out, err = capsys.readouterr()
-    return status, out, err
 
 
 def read_csv(text):

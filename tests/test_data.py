@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from cli.commands import main
 from core import PAPER_B, write_design
 from core.data import DataError, MeasuredStiffness
 from core.io.measured import MAX_BYTES, parse_loop, parse_stiffness, read_stiffness
+from tests.helpers import run
 
 HEAD = "frequency_hz,amplitude,magnitude,loss_factor\n"
 GOOD = HEAD + "10,1e-4,4.2e6,0.138\n20,1e-4,4.3e6,0.14\n"
@@ -113,14 +113,6 @@ def test_good_loop():
 
 
 # ---- through the command line --------------------------------------------------------------
-
-
-def run(argv, capsys):
-    try:
-        status = main([str(a) for a in argv])
-    except SystemExit as exc:
-        status = exc.code
-    return (status, *capsys.readouterr())
 
 
 @pytest.mark.parametrize("text,needle", BAD_STIFFNESS[:12])

@@ -127,7 +127,7 @@ HEAD = "frequency_hz,amplitude,magnitude,loss_factor\n"
     (HEAD + "10,1e-4,1e300,0.1\n", "line 2", "out_of_range"),
     ("frequency_hz,amplitude,magnitude\n10,1e-4,4e6\n", "line 1", "missing_key"),
     (HEAD.strip() + ",comment\n10,1e-4,4e6,0.1,ok\n", "line 1", "unknown_key"),
-    (HEAD.strip() + ",phase_deg\n10,1e-4,4e6,0.1,7\n", "line 1", "conflict"),
+    (HEAD.strip() + ",phase_deg\n10,1e-4,4e6,0.1,7\n", "line 2", "conflict"),
     ("mode," + HEAD + "shear,10,1e-4,4e6,0.1\n", "line 2", "bad_choice"),
     (HEAD + "10,1e-4,4e6,0.1,7\n", "", "bad_table"),
     (HEAD, "", "empty"),

@@ -76,7 +76,7 @@ def test_phase_limits_are_inclusive(phase):
     ("frequency_hz,amplitude,magnitude,phase_deg\n10,1e-4,2e6,1\n20,1e-4,2e6,-270\n", "line 3: phase_deg"),
     ("frequency_hz,amplitude,magnitude,phase_deg\n10,1e-4,-2e6,10\n", "line 2: magnitude must be positive"),
     ("frequency_hz,amplitude,magnitude,phase_deg\n10,1e-4,2e6,ten\n", "line 2: phase_deg is not a number"),
-    ("frequency_hz,amplitude,magnitude,loss_factor,phase_deg\n10,1e-4,2e6,0.1,5\n", "line 1: give one form"),
+    ("frequency_hz,amplitude,magnitude,loss_factor,phase_deg\n10,1e-4,2e6,0.1,5\n", "line 2: the two forms of the stiffness disagree"),
     ("frequency_hz,amplitude,stiffness_real,stiffness_imag\n10,1e-4,1.5e308,1.5e308\n", "line 2: the stiffness is zero or too large"),
     ("frequency_hz,amplitude,stiffness_real,stiffness_imag\n10,1e-4,0,0\n", "line 2: the stiffness is zero"),
 ])
