@@ -30,10 +30,11 @@ property's default at every read of a property never set: the class's overridden
 merged over its whole MRO, then the value validated (``Property.themed_default``), tens of
 thousands of times per page built and serialised. Where the default is an immutable value and
 no theme overrides it, the result is the same every time; it is kept per (property, class), and
-so is whether a property's default is unstable (asked at every such read, with two imports).
-Measured in process (8 page builds and serialisations, median, back to back): 744–782 ms of CPU
-per page without, 633–650 ms with. A test compares both with Bokeh's own answers for every
-property of every model class.
+so is whether a property's default is unstable (asked at every such read, with two imports); an
+empty list, dict or set default (every model's ``tags``, ``js_event_callbacks``, ...) is a new one
+of Bokeh's type per read, made without the merge. Measured (``benchmarks/page_cpu.py``): 744–782 ms
+of CPU per page without, 633–650 ms with the immutable defaults; the empty ones then took Bokeh's
+lookups from 5 500 to 950 per page. A test compares all with Bokeh's own answers.
 
 **BokehJS paint** (:data:`BOKEHJS_PAINT_PATCHES`, run in the page when its document is
 ready). Three costs BokehJS 3.9 pays on every paint: a plot component's stylesheet rewritten with
@@ -100,9 +101,9 @@ diagnosis report is written this way into plots made when its data were loaded
 (``benchmarks/diagnosis_report_cpu.py``: 1 065 ms of server CPU and 560 new models per report
 before, 79 ms and none after). HoloViews' per-update path (ranges, styles, legends and axes of every
 subplot recomputed) is skipped. Measured on the explorer with ``benchmarks/explorer_change.py``
-(30 changes, medians): server CPU per amplitude change 82 ms before this hook, 31 ms with it. Panel keeps a pane's HoloViews plots in the private
-``HoloViews._plots`` (one per root model); the plot's ``subplots``, ``handles`` and
-``get_data`` are HoloViews' own (Panel uses them the same way).
+(30 changes, medians): server CPU per amplitude change 82 ms before this hook, 31 ms with it. Panel
+keeps a pane's HoloViews plots in the private ``HoloViews._plots`` (one per root model); the plot's
+``subplots``, ``handles`` and ``get_data`` are HoloViews' own (Panel uses them the same way).
 """
 
 from __future__ import annotations
@@ -116,6 +117,7 @@ from pathlib import Path
 import numpy as np
 from bokeh.core.property.bases import Property
 from bokeh.core.property.descriptors import PropertyDescriptor
+from bokeh.core.property.wrappers import PropertyValueDict, PropertyValueList, PropertyValueSet
 from panel.io import resources as panel_resources
 from panel.io.document import hold as panel_hold
 from panel.io.server import DocHandler, WSHandler
@@ -173,6 +175,7 @@ def route_sessions(doc_handler, ws_handler) -> list:
 
 
 _IMMUTABLE = (type(None), bool, int, float, str)
+_EMPTY = (PropertyValueList, PropertyValueDict, PropertyValueSet)
 
 
 def _immutable(value) -> bool:
@@ -180,16 +183,17 @@ def _immutable(value) -> bool:
 
 
 def cache_immutable_defaults() -> None:
-    """Bokeh's ``Property.themed_default`` looked up once per (property, class) where the default
-    is an immutable value (None, a number, a string, a tuple of them) and no theme overrides it,
-    instead of at every read of a property never set (see the module). Other defaults (lists,
-    dicts, models, callables: a new one each time) and themed ones go to Bokeh's own code. And
-    whether a property's default is unstable (``PropertyDescriptor.has_unstable_default``, which
-    depends on the property and the class's overridden defaults only), once per pair."""
+    """Bokeh's ``Property.themed_default`` looked up once per (property, class) where no theme
+    overrides it and the default is immutable (None, a number, a string, a tuple of them: kept) or
+    an empty list, dict or set (its type kept: a new empty one per read), instead of at every read
+    of a property never set (see the module); other defaults go to Bokeh's own code. And whether a
+    property's default is unstable (``PropertyDescriptor.has_unstable_default``: the property's
+    and the class's overridden defaults' answer), once per pair."""
     original = Property.themed_default
     if getattr(original, "cached_by_bushing", False):
         return
     cache: dict = {}
+    empty: dict = {}
 
     def themed_default(self, cls, name, theme_overrides, *, no_eval=False):
         if theme_overrides is not None and name in theme_overrides:
@@ -197,9 +201,13 @@ def cache_immutable_defaults() -> None:
         key = (id(self), cls, name, no_eval)  # a Property lives as long as its class
         if key in cache:
             return cache[key]
+        if key in empty:
+            return empty[key]()
         value = original(self, cls, name, theme_overrides, no_eval=no_eval)
         if _immutable(value):
             cache[key] = value
+        elif type(value) in _EMPTY and not value:
+            empty[key] = type(value)
         return value
 
     themed_default.cached_by_bushing = True
@@ -297,18 +305,12 @@ def _script(name: str) -> str:
 
 
 BOKEHJS_PAINT_PATCHES = _script("paint_patches.js")
-
-
 BOKEHJS_SERVER_MODELS = _script("server_models.js")
-
-
 # A checkbox's or a switch's label toggles it (issue #27): BokehJS 3.9 draws the label as a <div>
 # beside the box (a Checkbox's <input>, a Switch's .bk-body) in the widget's shadow root, not as a
 # <label>, so a click on the words did nothing. One listener on the page: a click whose path (through
 # open shadow roots) holds such a label and not the box itself clicks the box of the same root.
 LABEL_CLICKS = _script("label_clicks.js")
-
-
 # window.bushingUploadAtOnce: "on" once installed, "unpatched" if Panel's FileDropper view has no
 # _process_upload (then FilePond sends the file itself, after its animations)
 UPLOAD_AT_ONCE = _script("upload_at_once.js")

@@ -94,3 +94,28 @@ def test_a_second_session_of_the_same_design_builds_only_its_loop_and_its_overla
     loop = {id(element) for element in elements(second, "loop")}
     rest = [element for element in built if id(element) not in loop]
     assert [type(element).__name__ for element in rest] == ["Overlay"] * len(KEYS)
+
+
+def test_a_page_reads_few_property_defaults_through_bokeh(monkeypatch):
+    """Bokeh merges a class's overridden defaults over its whole hierarchy at every read of a
+    property never set; :func:`app.patches.cache_immutable_defaults` keeps the immutable ones and
+    the type of the empty lists, dicts and sets (every model's ``tags``, ``js_event_callbacks``,
+    ...): a page built asks Bokeh fewer than 1 500 times (some 950; 5 500 with the immutable ones
+    alone, every model made reading its empty containers)."""
+    from bokeh.core.has_props import HasProps
+
+    from app import patches
+
+    patches.install()
+    rendered(App().template())  # the classes' first reads
+    asked = []
+    original = HasProps._overridden_defaults.__func__
+
+    def counted(cls):
+        asked.append(cls)
+        return original(cls)
+
+    monkeypatch.setattr(HasProps, "_overridden_defaults", classmethod(counted))
+    doc = rendered(App().template())
+    assert len(doc.models) > 500 and len(asked) < 1500, (len(doc.models), len(asked))
+
