@@ -119,3 +119,32 @@ def test_a_page_reads_few_property_defaults_through_bokeh(monkeypatch):
     doc = rendered(App().template())
     assert len(doc.models) > 500 and len(asked) < 1500, (len(doc.models), len(asked))
 
+
+def test_the_server_freezes_what_it_holds_before_its_first_session(monkeypatch):
+    """The objects a server process holds before its first session (the libraries, the app's
+    caches) are moved out of the interpreter's collections (``gc.freeze``) when it starts serving:
+    a collection of the oldest objects, which pages built trigger, no longer examines them."""
+    import gc
+
+    import panel as pn
+
+    from app import main
+
+    frozen = []
+
+    class Server:
+        port = 0
+
+        def start(self):
+            frozen.append(gc.get_freeze_count())
+
+        io_loop = type("Loop", (), {"start": staticmethod(lambda: None)})()
+
+    monkeypatch.setattr(pn, "serve", lambda *a, **k: Server())
+    monkeypatch.setattr(main.work, "use_processes", lambda: None)
+    monkeypatch.setattr(main.patches, "route_sessions", lambda *a: [])
+    try:
+        main.serve(port=0)
+    finally:
+        gc.unfreeze()
+    assert frozen and frozen[0] > 100_000, frozen
