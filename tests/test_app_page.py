@@ -360,3 +360,33 @@ def test_the_cached_property_defaults_are_bokehs_own(app):
                 assert ask(bare) is ask(bare) is ask.original(descriptor, bare), (cls, name)
     assert len(seen) > 300 and checked > 10_000 and containers > 100 and empties > 1000, (
         len(seen), checked, containers, empties)
+
+
+def test_holoviews_makes_no_selection_glyph_model_where_no_selection_style(monkeypatch):
+    """app.patches.selection_glyphs_auto: HoloViews' ``ElementPlot._update_glyph`` makes a Bokeh model
+    of a glyph renderer's ``"auto"`` selection glyph (the internal this saves: it still does, and
+    still takes these arguments); with the hook, a curve's renderer has none (BokehJS clones the
+    glyph for it, as for "auto"), and a curve styled for selections keeps HoloViews' model."""
+    import inspect
+
+    import holoviews as hv
+    from bokeh.models import GlyphRenderer
+    from holoviews.plotting.bokeh.element import ElementPlot
+
+    from app import patches
+
+    patches.install()
+    ours = ElementPlot._update_glyph
+    assert ours.by_bushing
+    assert list(inspect.signature(ours.original).parameters) == [
+        "self", "renderer", "properties", "mapping", "glyph", "source", "data"]
+
+    def selection_glyphs(element):
+        fig = hv.render(element, backend="bokeh")
+        return [r.selection_glyph for r in fig.references() if isinstance(r, GlyphRenderer)]
+
+    assert selection_glyphs(hv.Curve([1, 3, 2])) == [None]
+    styled = selection_glyphs(hv.Curve([1, 3, 2]).opts(selection_color="red"))
+    assert [(type(g).__name__, g.line_color) for g in styled] == [("Line", "red")]
+    monkeypatch.setattr(ElementPlot, "_update_glyph", ours.original)
+    assert [type(g).__name__ for g in selection_glyphs(hv.Curve([1, 3, 2]))] == ["Line"]

@@ -148,3 +148,19 @@ def test_the_server_freezes_what_it_holds_before_its_first_session(monkeypatch):
     finally:
         gc.unfreeze()
     assert frozen and frozen[0] > 100_000, frozen
+
+
+def test_a_page_has_no_selection_glyph_models():
+    """Each curve's glyph renderer holds its glyph, the one for points not selected and the muted
+    one: no selection glyph model (app.patches.selection_glyphs_auto; BokehJS clones the glyph for
+    it), three line glyphs per line renderer, 22 models fewer per page than HoloViews makes."""
+    from bokeh.models import GlyphRenderer, Line
+
+    from app import patches
+
+    patches.install()
+    doc = rendered(App().template())
+    renderers = [m for m in doc.models if isinstance(m, GlyphRenderer)]
+    lines = [r for r in renderers if isinstance(r.glyph, Line)]
+    assert len(lines) >= 20 and all(r.selection_glyph is None for r in renderers)
+    assert sum(isinstance(m, Line) for m in doc.models) == 3 * len(lines)
