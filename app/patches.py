@@ -119,10 +119,9 @@ _pages = weakref.WeakSet()  # documents that have the BokehJS patches
 
 
 def install(doc=None) -> None:
-    """Put the hooks of this module in place, each once however often it is called: the MathJax
-    decision and the number edits without debounce (process-wide), and the BokehJS paint patches
-    in the page of ``doc`` (if given, unless ``BUSHING_BOKEHJS_PATCHES=0``), and
-    :data:`BOKEHJS_SERVER_MODELS`, :data:`LABEL_CLICKS` and :data:`UPLOAD_AT_ONCE` in it (if given)."""
+    """Put the hooks of this module in place, each once however often it is called: the process-wide
+    ones, and in the page of ``doc`` (if given) the BokehJS paint patches (unless
+    ``BUSHING_BOKEHJS_PATCHES=0``), :data:`BOKEHJS_SERVER_MODELS`, :data:`LABEL_CLICKS`, :data:`UPLOAD_AT_ONCE`."""
     global _installed
     if not _installed:
         if hasattr(panel_resources, "_panel_use_mathjax"):
@@ -265,9 +264,13 @@ def hold_each_change() -> None:
 
 
 def holds_math(roots) -> bool:
-    """Whether any Panel HTML model under ``roots`` has text with math delimiters."""
-    return any(isinstance(model, PanelHTML) and MATH_DELIMITERS.search(model.text or "")
-               for root in roots for model in root.references())
+    """Whether a Panel HTML model under ``roots`` has math delimiters (a page's roots: its document's
+    set of models, not another walk of them, 17 ms per page served)."""
+    roots = list(roots)
+    doc = roots[0].document if roots else None
+    whole = doc is not None and len(roots) == len(doc.roots) and all(r.document is doc for r in roots)
+    models = doc.models if whole else (model for root in roots for model in root.references())
+    return any(isinstance(model, PanelHTML) and MATH_DELIMITERS.search(model.text or "") for model in models)
 
 
 @contextlib.contextmanager
@@ -323,16 +326,14 @@ def install_bokehjs_patches(doc):
 
 
 def holoviews_plots(pane) -> list:
-    """The HoloViews plots a Panel HoloViews pane has rendered (one per page showing it; none before
-    it is shown), each once (Panel files a plot under each root model it is rendered in: a page's
-    template and the pane's own root)."""
+    """The HoloViews plots a Panel HoloViews pane has rendered (one per page showing it), each once
+    (Panel files a plot under each root model it is rendered in: the template's, the pane's own)."""
     return list({id(plot): plot for plot, _model in getattr(pane, "_plots", {}).values()}.values())
 
 
 def _has(model, name: str) -> bool:
-    """Whether the Bokeh model ``model`` has the property ``name``: a look-up on its class (``hasattr``
-    on a model without it has Bokeh list similar names, with difflib, before it fails: measured here,
-    a tenth of a millisecond each, ten per change of the explorer)."""
+    """Whether the Bokeh model ``model`` has the property ``name``, looked up on its class (``hasattr``
+    has Bokeh list similar names with difflib before it fails: 0.1 ms each, ten per change)."""
     return getattr(type(model), name, None) is not None
 
 

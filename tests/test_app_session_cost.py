@@ -164,3 +164,28 @@ def test_a_page_has_no_selection_glyph_models():
     lines = [r for r in renderers if isinstance(r.glyph, Line)]
     assert len(lines) >= 20 and all(r.selection_glyph is None for r in renderers)
     assert sum(isinstance(m, Line) for m in doc.models) == 3 * len(lines)
+
+
+def test_the_mathjax_decision_walks_no_models_of_a_page_served(monkeypatch):
+    """Panel asks, for each page served, whether its texts hold math (app.patches.holds_math): for
+    all of a document's roots the answer reads the document's set of models, computed already,
+    instead of walking them again; roots of no document, or some of a document's, are walked."""
+    import panel as pn
+    from bokeh.model import Model
+
+    from app import patches
+
+    doc = rendered(App().template())
+    walks = []
+    original = Model.references
+
+    def counted(self):
+        walks.append(self)
+        return original(self)
+
+    monkeypatch.setattr(Model, "references", counted)
+    assert patches.holds_math(doc.roots) is False and walks == []
+    math = rendered(pn.Column(pn.pane.Markdown("Energy $$E = mc^2$$")))
+    walks.clear()  # those of its building
+    assert patches.holds_math(math.roots) is True and walks == []
+    assert patches.holds_math(doc.roots[:1]) is False and len(walks) == 1
