@@ -9,100 +9,87 @@ once per session; it installs each hook once) puts the process-wide hooks in pla
 BokehJS patches in the session's page. A notebook that imports the plotting API gets none of them.
 
 **Model recomputation.** Every HoloViews plot update freezes the Bokeh document's models, and
-Bokeh recomputes the set of models (a walk over every model's properties) whenever the last
-freeze ends, whether or not the model graph changed. Measured on the explorer's page (536
-models): 24 ms per recomputation, a fifth of the server's time per change, spent on changes that
-add no model (data, ranges, a marker). :func:`frozen_models` freezes the models for a whole
-change and recomputes them at its end only if something asked for it (``invalidate``, which Bokeh
-calls when a property change adds or removes models). Upstream, Bokeh's
-``DocumentModelManager`` could do the same: remember an ``invalidate`` while frozen, and
-recompute at the last unfreeze only then (``add_root`` and ``remove_root`` would invalidate
-explicitly).
+Bokeh recomputes the set of models (a walk over every model) whenever the last freeze ends,
+whether or not the model graph changed: 24 ms per walk of the explorer's page, a fifth of the
+server's time per change. :func:`frozen_models` freezes the models for a whole change and
+recomputes them at its end only if Bokeh asked for it (``invalidate``: models added or removed).
+Upstream, Bokeh's ``DocumentModelManager`` could remember an ``invalidate`` while frozen.
 
 **Sessions admitted** (:func:`route_sessions`). Bokeh's server takes its per-app routes from the
-module list ``bokeh.server.urls.per_app_patterns`` (which Panel rewrites with its own handlers on
-import); the explorer's server routes pages and websockets to Panel's handlers with
-:mod:`app.admission`'s check in front, so that a burst of new sessions is refused with a "busy"
-page instead of queueing on the server's one thread.
+module list ``bokeh.server.urls.per_app_patterns`` (which Panel rewrites on import); the explorer
+routes pages and websockets to Panel's handlers with :mod:`app.admission`'s check in front: a burst
+of new sessions is refused with a "busy" page instead of queueing on the server's one thread.
 
 **Property defaults looked up once** (:func:`cache_immutable_defaults`). Bokeh 3.9 computes a
 property's default at every read of a property never set: the class's overridden defaults
 merged over its whole MRO, then the value validated (``Property.themed_default``), tens of
 thousands of times per page built and serialised. Where the default is an immutable value and
 no theme overrides it, the result is the same every time; it is kept per (property, class), and
-so is whether a property's default is unstable (asked at every such read, with two imports).
-Measured in process (8 page builds and serialisations, median, back to back): 744–782 ms of CPU
-per page without, 633–650 ms with. A test compares both with Bokeh's own answers for every
-property of every model class.
+so is whether a property's default is unstable (asked at every such read, with two imports); an
+empty list, dict or set default (every model's ``tags``, ``js_event_callbacks``, ...) is a new one
+of Bokeh's type per read, made without the merge. Measured (``benchmarks/page_cpu.py``): 744–782 ms
+of CPU per page without, 633–650 ms with the immutable defaults; the empty ones then took Bokeh's
+lookups from 5 500 to 950 per page. A test compares all with Bokeh's own answers.
 
 **BokehJS paint** (:data:`BOKEHJS_PAINT_PATCHES`, run in the page when its document is
 ready). Three costs BokehJS 3.9 pays on every paint: a plot component's stylesheet rewritten with
 the text it already has (each rewrite makes Chromium recollect the page's styles); every visual
 property read asking the CSS cascade for a ``--bk-*`` variable (cached here until the running
 script returns, as bokeh/bokeh#15205 does after 3.9); a glyph renderer placing its empty element
-by rewriting a stylesheet of its own (set here as the element's inline style). Each method is
-looked up first and nothing is patched if it is missing; a browser test checks that all three
-are active and still behave as Bokeh's own code. Measured on the HoloViews explorer, one session,
-A/B twice: Chromium's renderer 59–60 ms per change with them, 71–82 ms without; median latency
-141–144 ms against 156–164 ms. ``BUSHING_BOKEHJS_PATCHES=0`` leaves them out, to measure again.
+by rewriting a stylesheet of its own (set here as the element's inline style). A method missing,
+nothing is patched; a browser test checks all three are active and behave as Bokeh's own. Chromium's
+renderer 59–60 ms per change with them, 71–82 ms without (``BUSHING_BOKEHJS_PATCHES=0``).
 
 **Models from the server are known to it** (:data:`BOKEHJS_SERVER_MODELS`, run in every page).
 BokehJS 3.9 counts a model that a server patch brings (a tab's content shown for the first time) as
-new to the server until the page sends its next patch, and that patch sends the model again in
-full: the server warns ``reference already known`` (``BokehUserWarning``), e.g. on the first click
-in the diagnosis tab, whose widgets arrive with the tab and which draws no plot (a plot's first
-paint sends a patch and hides it elsewhere). The page takes the models of each server patch as
-known: a model the page makes itself stays new.
+new to the server until the page's next patch, which sends it again in full: the server warns
+``reference already known`` (e.g. the first click in the diagnosis tab). The page takes the models
+of each server patch as known: a model the page makes itself stays new.
 
 **Stylesheets from this server** (:func:`local_stylesheets`). Panel addresses its stylesheets
 against the document's ``dist_url`` (Bokeh's private ``Document._template_variables``), set only
 when the page is rendered; a component built before that and first sent after an upload asked
-the CDN for ``loading.css`` (a console error; nothing loaded offline). Set at session start.
+the CDN for ``loading.css`` (a console error; nothing loaded offline). Set at session start to
+:func:`panel.io.resources.get_dist_path` (this server's path unless the resources are the CDN).
 
-**MathJax.** Panel 1.9 sends Bokeh's MathJax bundle (1.8 MB, the largest script of the page) whenever the
-page holds an HTML pane, in case one holds math (holoviz/panel#8424; holoviz/panel#8179 would
-load it late instead). The explorer's texts hold none: the bundle is sent only to a page whose
-texts have math delimiters. Measured here: about 0.1 s of each page load.
+**No selection glyph models** (:func:`selection_glyphs_auto`). HoloViews 1.23 makes a model of
+every glyph renderer's ``"auto"`` selection glyph (``ElementPlot._update_glyph``): the glyph's
+properties and the element's ``selection_*`` styles. With no such style, that is what BokehJS
+clones for a renderer without one. 22 models fewer per page (536 to 514), 25 ms less CPU per page.
+
+**MathJax.** Panel 1.9 sends Bokeh's MathJax bundle (1.8 MB) whenever the page holds an HTML pane
+(holoviz/panel#8424); it is sent only to a page whose texts have math delimiters (0.1 s per load).
 
 **Number edits without debounce** (:func:`send_values_at_once`). Panel holds every change of a
-widget's property from the page for 50 ms (``Syncable._debounce``) before processing it, in case
-another follows, except the properties a class lists in its private ``_priority_changes`` (as
-Panel's Tabulator does for its data). The app's number inputs and sliders (:data:`app.inputs.IMMEDIATE`)
-list ``value``: every typed or dragged number is processed at once. That is 50 ms less per edit
-by construction, and it is also correct behaviour: with the debounce, a click right after typing
-(the design form's "Find designs") was processed before the typed value, on the old one.
+widget's property from the page for 50 ms (``Syncable._debounce``), except the properties a class
+lists in its private ``_priority_changes`` (as Panel's Tabulator does for its data). The app's
+number widgets (:data:`app.inputs.IMMEDIATE`) list ``value``: 50 ms less per edit, and a click right
+after typing ("Find designs") is no longer processed before the typed value, on the old one.
 
 **One message per change** (:func:`hold_each_change`). On a server, Panel processes a change from
-the page (``Syncable._change_event``) without holding the document: each property the change sets
-goes to the page as its own message, as it is set. A mode switch then painted the amplitude
-slider in the new mode's unit beside the operating point's text in the old one for some 13
-frames, until the plots were computed (a browser test samples every frame). Held, everything
-a change sets arrives in one message and is painted at once.
+the page (``Syncable._change_event``) without holding the document: each property set went as its
+own message (a mode switch painted the slider's new unit beside the old one's text for some 13
+frames; a browser test samples every frame). Held, a change arrives in one message.
 
 **A file is sent as soon as its drop area has it** (:data:`UPLOAD_AT_ONCE`; issue #27 item 16).
-FilePond starts processing (Panel's FileDropper sends from its ``server.process``) only once its
-animations rest: a CSV left the page 1.1 s after the drop area had it, of 1.9 s to its summary
-(``benchmarks/upload_speed.py``). The page sends it at FilePond's ``addfile`` (type and size
-checked) through the view's ``_process_upload``; FilePond's later ``process`` only completes the
-item. *Browse* hands the file to FilePond (``addFiles``) at once, not 250 ms later as its input
-does. A browser test checks that the bytes leave, once, while FilePond still holds the file queued.
+FilePond processes (Panel's FileDropper sends from its ``server.process``) only once its animations
+rest: a CSV left 1.1 s after the drop, of 1.9 s to its summary (``benchmarks/upload_speed.py``).
+The page sends it at FilePond's ``addfile`` (type and size checked) through the view's
+``_process_upload``; *Browse* hands the file to FilePond (``addFiles``) at once, not 250 ms later.
+A browser test checks that the bytes leave, once, while FilePond still holds the file queued.
 
 **Data-only updates** (:func:`holoviews_plots`, :func:`written`). HoloViews builds each plot
 (its dimensions, styles, legend, linked axes, tap stream); a later frame with the same elements
-(kinds, labels, styles, dimensions) differs only in its numbers, and those are written into the
-Bokeh models HoloViews made: each changed element's columns (HoloViews' own ``get_data`` makes
-them) into its glyph's data source, a marker's position into its span, the frame's axis ranges
-into the figure's ranges (and the Reset tool's), the words of its dimensions (labels and units,
-new after a mode switch) into the axis labels and the hover tooltips; a bar chart's categories
-into its categorical axis, a map's colour span (its colour dimension's range) into its colour
-mapper, and an axis HoloViews ranged from the data is kept while their extent is unchanged. The
-diagnosis report is written this way into plots made when its data were loaded
-(``benchmarks/diagnosis_report_cpu.py``: 1 065 ms of server CPU and 560 new models per report
-before, 79 ms and none after). HoloViews' per-update path (ranges, styles, legends and axes of every
-subplot recomputed) is skipped. Measured on the explorer with ``benchmarks/explorer_change.py``
-(30 changes, medians): server CPU per amplitude change 82 ms before this hook, 31 ms with it. Panel keeps a pane's HoloViews plots in the private
-``HoloViews._plots`` (one per root model); the plot's ``subplots``, ``handles`` and
-``get_data`` are HoloViews' own (Panel uses them the same way).
+(kinds, labels, styles, dimensions) differs only in its numbers, written into the Bokeh models
+HoloViews made: each changed element's columns (HoloViews' own ``get_data``) into its data source,
+a marker's position, the axis ranges (and the Reset tool's), the dimensions' words (after a mode
+switch) into the axis labels and tooltips, a bar chart's categories, a map's colour span; an axis
+HoloViews ranged from the data is kept while their extent is. The diagnosis report is written
+this way (``benchmarks/diagnosis_report_cpu.py``: 1 065 ms of server CPU and 560 new models per
+report before, 79 ms and none after); an amplitude change of the explorer 82 ms before, 31 ms
+after (``benchmarks/explorer_change.py``), HoloViews' per-update path skipped. Panel
+keeps a pane's HoloViews plots in the private ``HoloViews._plots`` (one per root model); the plot's
+``subplots``, ``handles`` and ``get_data`` are HoloViews' own (Panel uses them the same way).
 """
 
 from __future__ import annotations
@@ -116,6 +103,7 @@ from pathlib import Path
 import numpy as np
 from bokeh.core.property.bases import Property
 from bokeh.core.property.descriptors import PropertyDescriptor
+from bokeh.core.property.wrappers import PropertyValueDict, PropertyValueList, PropertyValueSet
 from panel.io import resources as panel_resources
 from panel.io.document import hold as panel_hold
 from panel.io.server import DocHandler, WSHandler
@@ -131,10 +119,9 @@ _pages = weakref.WeakSet()  # documents that have the BokehJS patches
 
 
 def install(doc=None) -> None:
-    """Put the hooks of this module in place, each once however often it is called: the MathJax
-    decision and the number edits without debounce (process-wide), and the BokehJS paint patches
-    in the page of ``doc`` (if given, unless ``BUSHING_BOKEHJS_PATCHES=0``), and
-    :data:`BOKEHJS_SERVER_MODELS`, :data:`LABEL_CLICKS` and :data:`UPLOAD_AT_ONCE` in it (if given)."""
+    """Put the hooks of this module in place, each once however often it is called: the process-wide
+    ones, and in the page of ``doc`` (if given) the BokehJS paint patches (unless
+    ``BUSHING_BOKEHJS_PATCHES=0``), :data:`BOKEHJS_SERVER_MODELS`, :data:`LABEL_CLICKS`, :data:`UPLOAD_AT_ONCE`."""
     global _installed
     if not _installed:
         if hasattr(panel_resources, "_panel_use_mathjax"):
@@ -144,6 +131,7 @@ def install(doc=None) -> None:
         send_values_at_once(IMMEDIATE)
         hold_each_change()
         cache_immutable_defaults()
+        selection_glyphs_auto()
         _installed = True
     if doc is not None and doc not in _pages:
         if os.environ.get("BUSHING_BOKEHJS_PATCHES", "1") == "1":
@@ -173,6 +161,7 @@ def route_sessions(doc_handler, ws_handler) -> list:
 
 
 _IMMUTABLE = (type(None), bool, int, float, str)
+_EMPTY = (PropertyValueList, PropertyValueDict, PropertyValueSet)
 
 
 def _immutable(value) -> bool:
@@ -180,16 +169,17 @@ def _immutable(value) -> bool:
 
 
 def cache_immutable_defaults() -> None:
-    """Bokeh's ``Property.themed_default`` looked up once per (property, class) where the default
-    is an immutable value (None, a number, a string, a tuple of them) and no theme overrides it,
-    instead of at every read of a property never set (see the module). Other defaults (lists,
-    dicts, models, callables: a new one each time) and themed ones go to Bokeh's own code. And
-    whether a property's default is unstable (``PropertyDescriptor.has_unstable_default``, which
-    depends on the property and the class's overridden defaults only), once per pair."""
+    """Bokeh's ``Property.themed_default`` looked up once per (property, class) where no theme
+    overrides it and the default is immutable (None, a number, a string, a tuple of them: kept) or
+    an empty list, dict or set (its type kept: a new empty one per read), instead of at every read
+    of a property never set (see the module); other defaults go to Bokeh's own code. And whether a
+    property's default is unstable (``PropertyDescriptor.has_unstable_default``: the property's
+    and the class's overridden defaults' answer), once per pair."""
     original = Property.themed_default
     if getattr(original, "cached_by_bushing", False):
         return
     cache: dict = {}
+    empty: dict = {}
 
     def themed_default(self, cls, name, theme_overrides, *, no_eval=False):
         if theme_overrides is not None and name in theme_overrides:
@@ -197,9 +187,13 @@ def cache_immutable_defaults() -> None:
         key = (id(self), cls, name, no_eval)  # a Property lives as long as its class
         if key in cache:
             return cache[key]
+        if key in empty:
+            return empty[key]()
         value = original(self, cls, name, theme_overrides, no_eval=no_eval)
         if _immutable(value):
             cache[key] = value
+        elif type(value) in _EMPTY and not value:
+            empty[key] = type(value)
         return value
 
     themed_default.cached_by_bushing = True
@@ -219,16 +213,28 @@ def cache_immutable_defaults() -> None:
     PropertyDescriptor.has_unstable_default = has_unstable_default
 
 
+def selection_glyphs_auto() -> None:
+    """The glyph renderers HoloViews makes, while not yet in a document, left without a selection
+    glyph model unless their element has ``selection_*`` styles (see the module)."""
+    from holoviews.plotting.bokeh.element import ElementPlot
+
+    original = ElementPlot._update_glyph
+    if getattr(original, "by_bushing", False):
+        return
+
+    def _update_glyph(self, renderer, properties, *args, **kwargs):
+        if renderer is not None and renderer.document is None and renderer.selection_glyph == "auto" \
+                and not any(str(k).startswith("selection_") for k in properties):
+            renderer.selection_glyph = None  # BokehJS clones the glyph for it, as for "auto"
+        return original(self, renderer, properties, *args, **kwargs)
+
+    _update_glyph.by_bushing, _update_glyph.original = True, original
+    ElementPlot._update_glyph = _update_glyph
+
+
 def local_stylesheets(doc) -> None:
     """Panel's stylesheets of every component of ``doc`` from this server, also of those built
-    before the page is rendered. Panel writes a component's stylesheet addresses against the
-    document's ``dist_url`` template variable (Bokeh's private ``Document._template_variables``),
-    which it sets only when it renders the page; until then it takes its CDN. A component built
-    with the session and first sent later (a measured-data tab's plots after an upload) then made
-    the page fetch ``loading.css`` from the CDN: a console error, and nothing loaded where the
-    server has no internet. Set here, before the session builds anything, to what Panel sets
-    at render (:func:`panel.io.resources.get_dist_path`: this server's path unless the resources
-    are the CDN)."""
+    before the page is rendered, as Panel sets it at render (see the module)."""
     doc._template_variables.setdefault("dist_url", panel_resources.get_dist_path())
 
 
@@ -258,9 +264,13 @@ def hold_each_change() -> None:
 
 
 def holds_math(roots) -> bool:
-    """Whether any Panel HTML model under ``roots`` has text with math delimiters."""
-    return any(isinstance(model, PanelHTML) and MATH_DELIMITERS.search(model.text or "")
-               for root in roots for model in root.references())
+    """Whether a Panel HTML model under ``roots`` has math delimiters (a page's roots: its document's
+    set of models, not another walk of them, 17 ms per page served)."""
+    roots = list(roots)
+    doc = roots[0].document if roots else None
+    whole = doc is not None and len(roots) == len(doc.roots) and all(r.document is doc for r in roots)
+    models = doc.models if whole else (model for root in roots for model in root.references())
+    return any(isinstance(model, PanelHTML) and MATH_DELIMITERS.search(model.text or "") for model in models)
 
 
 @contextlib.contextmanager
@@ -297,18 +307,12 @@ def _script(name: str) -> str:
 
 
 BOKEHJS_PAINT_PATCHES = _script("paint_patches.js")
-
-
 BOKEHJS_SERVER_MODELS = _script("server_models.js")
-
-
 # A checkbox's or a switch's label toggles it (issue #27): BokehJS 3.9 draws the label as a <div>
 # beside the box (a Checkbox's <input>, a Switch's .bk-body) in the widget's shadow root, not as a
 # <label>, so a click on the words did nothing. One listener on the page: a click whose path (through
 # open shadow roots) holds such a label and not the box itself clicks the box of the same root.
 LABEL_CLICKS = _script("label_clicks.js")
-
-
 # window.bushingUploadAtOnce: "on" once installed, "unpatched" if Panel's FileDropper view has no
 # _process_upload (then FilePond sends the file itself, after its animations)
 UPLOAD_AT_ONCE = _script("upload_at_once.js")
@@ -322,16 +326,14 @@ def install_bokehjs_patches(doc):
 
 
 def holoviews_plots(pane) -> list:
-    """The HoloViews plots a Panel HoloViews pane has rendered (one per page showing it; none before
-    it is shown), each once (Panel files a plot under each root model it is rendered in: a page's
-    template and the pane's own root)."""
+    """The HoloViews plots a Panel HoloViews pane has rendered (one per page showing it), each once
+    (Panel files a plot under each root model it is rendered in: the template's, the pane's own)."""
     return list({id(plot): plot for plot, _model in getattr(pane, "_plots", {}).values()}.values())
 
 
 def _has(model, name: str) -> bool:
-    """Whether the Bokeh model ``model`` has the property ``name``: a look-up on its class (``hasattr``
-    on a model without it has Bokeh list similar names, with difflib, before it fails: measured here,
-    a tenth of a millisecond each, ten per change of the explorer)."""
+    """Whether the Bokeh model ``model`` has the property ``name``, looked up on its class (``hasattr``
+    has Bokeh list similar names with difflib before it fails: 0.1 ms each, ten per change)."""
     return getattr(type(model), name, None) is not None
 
 

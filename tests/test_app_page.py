@@ -318,7 +318,8 @@ def test_the_cached_property_defaults_are_bokehs_own(app):
     """app.patches.cache_immutable_defaults keeps Bokeh's property defaults per (property, class):
     for every property of every Bokeh and Panel model class, read through the cache (twice: the
     second read is the cached one) and through Bokeh's own ``themed_default``, the same immutable
-    value; and any other default (a list, a dict, a model) a new one at each read, as Bokeh makes it."""
+    value; and any other default (a list, a dict, a set, a model) a new one at each read, as Bokeh
+    makes it (an empty container: a new empty one of Bokeh's type, from the cache)."""
     import inspect
 
     from bokeh.core.has_props import HasProps
@@ -331,7 +332,7 @@ def test_the_cached_property_defaults_are_bokehs_own(app):
     ours = Property.themed_default
     assert ours.cached_by_bushing
     assert list(inspect.signature(ours.original).parameters) == ["self", "cls", "name", "theme_overrides", "no_eval"]
-    classes, seen, containers = [HasProps], set(), 0
+    classes, seen, containers, empties = [HasProps], set(), 0, 0
     while classes:
         cls = classes.pop()
         classes.extend(c for c in cls.__subclasses__() if c not in seen)
@@ -346,11 +347,46 @@ def test_the_cached_property_defaults_are_bokehs_own(app):
                     cached = ours(prop, cls, name, None)
                     assert _same(cached, bokeh), (cls, name, cached, bokeh)
                     checked += 1
-            elif isinstance(bokeh, (list, dict, HasProps)):  # Bokeh's own: a new one at each read
+            elif isinstance(bokeh, (list, dict, set, HasProps)):  # a new one at each read
                 containers += 1
-                assert ours(prop, cls, name, None) is not ours(prop, cls, name, None), (cls, name)
+                first, second = ours(prop, cls, name, None), ours(prop, cls, name, None)
+                assert first is not second, (cls, name)
+                if not isinstance(bokeh, HasProps) and not bokeh:  # empty: its type kept, Bokeh's value
+                    empties += 1
+                    assert _same(first, bokeh) and _same(second, bokeh), (cls, name, first, bokeh)
             descriptor, bare = cls.lookup(name), object.__new__(cls)  # an instance's class is all it reads
             if isinstance(descriptor, PropertyDescriptor):  # not an alias of another property
                 ask = descriptor.has_unstable_default
                 assert ask(bare) is ask(bare) is ask.original(descriptor, bare), (cls, name)
-    assert len(seen) > 300 and checked > 10_000 and containers > 100, (len(seen), checked, containers)
+    assert len(seen) > 300 and checked > 10_000 and containers > 100 and empties > 1000, (
+        len(seen), checked, containers, empties)
+
+
+def test_holoviews_makes_no_selection_glyph_model_where_no_selection_style(monkeypatch):
+    """app.patches.selection_glyphs_auto: HoloViews' ``ElementPlot._update_glyph`` makes a Bokeh model
+    of a glyph renderer's ``"auto"`` selection glyph (the internal this saves: it still does, and
+    still takes these arguments); with the hook, a curve's renderer has none (BokehJS clones the
+    glyph for it, as for "auto"), and a curve styled for selections keeps HoloViews' model."""
+    import inspect
+
+    import holoviews as hv
+    from bokeh.models import GlyphRenderer
+    from holoviews.plotting.bokeh.element import ElementPlot
+
+    from app import patches
+
+    patches.install()
+    ours = ElementPlot._update_glyph
+    assert ours.by_bushing
+    assert list(inspect.signature(ours.original).parameters) == [
+        "self", "renderer", "properties", "mapping", "glyph", "source", "data"]
+
+    def selection_glyphs(element):
+        fig = hv.render(element, backend="bokeh")
+        return [r.selection_glyph for r in fig.references() if isinstance(r, GlyphRenderer)]
+
+    assert selection_glyphs(hv.Curve([1, 3, 2])) == [None]
+    styled = selection_glyphs(hv.Curve([1, 3, 2]).opts(selection_color="red"))
+    assert [(type(g).__name__, g.line_color) for g in styled] == [("Line", "red")]
+    monkeypatch.setattr(ElementPlot, "_update_glyph", ours.original)
+    assert [type(g).__name__ for g in selection_glyphs(hv.Curve([1, 3, 2]))] == ["Line"]
