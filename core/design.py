@@ -23,6 +23,7 @@ from .rules import (
     BAD_TYPE,
     DUPLICATE_KEY,
     DesignError,
+    excerpt,
 )
 from .shape import shape_factor, strain_factor
 
@@ -89,9 +90,9 @@ class Design:
 
     def __post_init__(self):
         if self.mode not in MODES:
-            raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {self.mode!r}", BAD_CHOICE)
+            raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {excerpt(repr(self.mode))}", BAD_CHOICE)
         if self.shape is not None and self.shape not in SHAPES:
-            raise DesignError("shape", f"must be one of {', '.join(SHAPES)}, got {self.shape!r}", BAD_CHOICE)
+            raise DesignError("shape", f"must be one of {', '.join(SHAPES)}, got {excerpt(repr(self.shape))}", BAD_CHOICE)
         if self.shape == "long" and no_long_form(self.mode):
             raise DesignError("shape", no_long_form(self.mode), BAD_CHOICE)
         if not isinstance(self.geometry, Geometry):
@@ -99,7 +100,7 @@ class Design:
         if not isinstance(self.material, Material):
             raise DesignError("material", "must be a Material", BAD_TYPE)
         if self.name is not None and not isinstance(self.name, str):
-            raise DesignError("name", f"must be a string, got {self.name!r}", BAD_TYPE)
+            raise DesignError("name", f"must be a string, got {excerpt(repr(self.name))}", BAD_TYPE)
         effects = _frozen_effects(self.effects)
         own = f"@{self.mode}"
         if any(eid.endswith(own) for eid, _ in effects):  # tied to this design's own mode: plain

@@ -26,7 +26,7 @@ from .material import REFERENCE_FREQUENCY_HZ
 from .material import branch_moduli as material_branch_moduli
 from .parameters import BRANCH_PARAMETERS, BY_NAME, MODE, MODES, TRANSLATIONS, Parameter
 from .parts import Material
-from .rules import BAD_CHOICE, BAD_TYPE, MISSING_KEY, NEGATIVE, UNKNOWN_KEY, DesignError
+from .rules import BAD_CHOICE, BAD_TYPE, MISSING_KEY, NEGATIVE, UNKNOWN_KEY, DesignError, excerpt
 from .rules import number as _number
 from .shape import long_shape_factor
 
@@ -213,7 +213,7 @@ def validate_effects(effects: Any) -> dict[str, dict[str, float]]:
             raise DesignError(key, f"only an effect of the test rig ({rigs}) can be tied to a mode; "
                                    f"{base} is the rubber's and acts in every mode", BAD_CHOICE)
         if mode is not None and mode not in MODES:
-            raise DesignError(key, f"the mode after @ must be one of {', '.join(MODES)}, got {mode!r}",
+            raise DesignError(key, f"the mode after @ must be one of {', '.join(MODES)}, got {excerpt(repr(mode))}",
                               BAD_CHOICE)
         if effect.branch:
             raise DesignError(key, "is a branch of the material model; its parameters belong in "

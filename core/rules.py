@@ -90,6 +90,7 @@ _NOT_FINITE_WORDS = ("nan", "inf", "infinity")
 # the characters of an input's value a message quotes (a cell, a column name, a typed text):
 # enough to recognise it, never the megabytes a hostile file may hold
 EXCERPT_CHARS = 40
+KEY_CHARS = 80  # a key (dotted path) as a message names it: longer ones are cut
 
 
 class RuleError(ValueError):
@@ -129,7 +130,7 @@ class RuleError(ValueError):
         if code not in CODES:
             raise ValueError(f"unknown rule code {code!r}")
         self.key, self.rule, self.code = key, rule, code
-        super().__init__(f"{key}: {rule}" if key else rule)
+        super().__init__(f"{excerpt(key, KEY_CHARS)}: {rule}" if key else rule)  # a file's key may be long
 
 
 class DesignError(RuleError):
@@ -175,13 +176,13 @@ def number(key: str, value: Any, error: type[RuleError] = DesignError) -> float:
     float (a bool is no number), NaN or an infinity, an integer too large for a float. A
     design's rule (:class:`DesignError`) unless ``error`` says otherwise."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise error(key, f"must be a number, got {value!r}", NOT_A_NUMBER)
+        raise error(key, f"must be a number, got {excerpt(repr(value))}", NOT_A_NUMBER)
     try:
         finite = float(value)
     except OverflowError:  # an integer too large for a float
         raise error(key, "must be a finite number, got an integer too large for a float", OVERFLOW) from None
     if not math.isfinite(finite):
-        raise error(key, f"must be a finite number, got {value!r}", NOT_FINITE)
+        raise error(key, f"must be a finite number, got {excerpt(repr(value))}", NOT_FINITE)
     return finite
 
 

@@ -265,3 +265,24 @@ def test_the_shape_words_of_the_design_file():
     radial.update(mode="radial", shape="long")
     design = design_from_dict(radial)
     assert design.shape_kind == "long" and json.loads(dumps_design(design))["shape"] == "long"
+
+
+@pytest.mark.parametrize("where", ["key", "mode", "shape", "number", "effect"])
+def test_a_long_key_or_value_is_quoted_short(where):
+    """A design file's message quotes what it refuses in a few dozen characters, however long the
+    key or value (a 300 000-character one made a message line of 300 kB), naming the same key."""
+    data = paper_b_dict()
+    long = "q" * 300_000
+    if where == "key":
+        data[long] = 1
+    elif where == "mode":
+        data["mode"] = long
+    elif where == "shape":
+        data["shape"] = long
+    elif where == "number":
+        data["material"]["shear_modulus"] = long
+    else:
+        data["effects"] = {long: {}}
+    with pytest.raises(DesignError) as caught:
+        loads_design(json.dumps(data))
+    assert len(str(caught.value)) < 300 and "q" * 30 in str(caught.value) and "…" in str(caught.value)

@@ -30,6 +30,7 @@ from ..rules import (
     DesignError,
     Words,
     decoded,
+    excerpt,
     read_text,
     strict_json,
 )
@@ -72,10 +73,10 @@ def design_from_dict(data: Any) -> Design:
     if "fit" in data and not isinstance(data["fit"], Mapping):  # a fitted file's report: kept aside
         raise DesignError("fit", "must be an object (the report of `bushing fit`)", BAD_TYPE)
     if not isinstance(data["mode"], str):
-        raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {data['mode']!r}", BAD_CHOICE)
+        raise DesignError("mode", f"must be one of {', '.join(MODES)}, got {excerpt(repr(data['mode']))}", BAD_CHOICE)
     shape = data.get("shape")
     if shape is not None and (not isinstance(shape, str) or shape not in SHAPE_FROM_FILE):
-        raise DesignError("shape", f"must be one of {', '.join(FILE_SHAPE.values())}, got {shape!r}", BAD_CHOICE)
+        raise DesignError("shape", f"must be one of {', '.join(FILE_SHAPE.values())}, got {excerpt(repr(shape))}", BAD_CHOICE)
     if shape == "thesis" and thesis_shape_refused(data["mode"]):
         raise DesignError("shape", thesis_shape_refused(data["mode"]), BAD_CHOICE)
     material = Material(**data["material"])
