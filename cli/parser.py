@@ -12,7 +12,7 @@ from core.element.coefficients import MAX_SLICES as ELEMENT_SLICES
 from core.element.prony import MAX_DECADES as MAX_BAND_DECADES
 from core.io.export import FORMATS
 from core.parameters import BRANCH_PARAMETERS, MODE, ROTATIONS, TRANSLATIONS
-from core.rules import OVERFLOW, WHOLE, RuleError, decimal
+from core.rules import OVERFLOW, WHOLE, RuleError, decimal, excerpt
 
 NUMBER_FORMAT = "{:.12g}"
 # the largest sizes the command line computes (docs/files.md): a grid of at most a million
@@ -64,7 +64,7 @@ def _frequency(name):
         lo, hi = MEASURED_FREQUENCY_HZ
         if not lo <= value <= hi:
             raise argparse.ArgumentTypeError(f"{name} must be within {lo:g}–{hi:g} Hz (a rubber bushing's "
-                                             f"frequencies, as measured files hold), got {text[:40]!r}")
+                                             f"frequencies, as measured files hold), got {excerpt(repr(text))}")
         return value
 
     return parse

@@ -207,6 +207,11 @@ SHAPES = ("long", "finite")  # closed forms of long bushings, or the finite-leng
 # closed form, is read as well and written for the plane-strain radial one, no formula of the thesis
 FILE_SHAPE = {"long": "thesis", "finite": "finite"}
 SHAPE_FROM_FILE = {"thesis": "long", "long": "long", "finite": "finite"}
+DEFAULT_SHAPE = {m.name: m.default_shape for m in MODE_TABLE}
+TRANSLATIONS = tuple(m.name for m in MODE_TABLE if not m.rotation)  # amplitude in m, stiffness in N/m
+ROTATIONS = tuple(m.name for m in MODE_TABLE if m.rotation)  # amplitude in rad, stiffness in N·m/rad
+# the thesis' own modes, long by default: its closed forms (eqs 17, 18), slices and continuum
+THESIS_MODES = tuple(m.name for m in MODE_TABLE if m.default_shape == "long")
 
 
 def file_shape(mode_name: str, shape: str) -> str:
@@ -220,11 +225,6 @@ def thesis_shape_refused(mode_name: str) -> str | None:
     if mode_name not in MODE or MODE[mode_name].long_equation is not None:
         return None
     return f"{mode_name}: the thesis' closed forms are axial (eq 18) and torsion (eq 17); use shape 'finite'"
-DEFAULT_SHAPE = {m.name: m.default_shape for m in MODE_TABLE}
-TRANSLATIONS = tuple(m.name for m in MODE_TABLE if not m.rotation)  # amplitude in m, stiffness in N/m
-ROTATIONS = tuple(m.name for m in MODE_TABLE if m.rotation)  # amplitude in rad, stiffness in N·m/rad
-# the thesis' own modes, long by default: its closed forms (eqs 17, 18), slices and continuum
-THESIS_MODES = tuple(m.name for m in MODE_TABLE if m.default_shape == "long")
 
 
 def mode(name: str) -> Mode:
