@@ -1,11 +1,12 @@
-"""Which shape factor a view uses, in one phrase, and the design the views of every direction get.
+"""Which shape factor a view uses, in one phrase.
 
 The one setting is the design's ``shape`` (the sidebar's *Finite-length shape factor* switch,
 :attr:`app.state.ExplorerState.finite_length`): ``finite``, the finite-length FE table in every
-direction; otherwise (None, or ``long`` from a file) the thesis' long-bushing formulas where they
+direction; otherwise (None, or ``thesis`` from a file) the thesis' long-bushing formulas where they
 exist, axial (eq 18) and torsion (eq 17), and the finite-length table for radial and conical,
-which have none that holds at real lengths. Every view that draws a design says which it uses
-with :func:`shape_phrase`.
+which have none that holds at real lengths: the design file's rule, which the card and the
+exports follow too (:func:`core.card.card_design`). Every view that draws a design says which it
+uses with :func:`shape_phrase`.
 """
 
 from __future__ import annotations
