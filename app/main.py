@@ -5,6 +5,7 @@ from __future__ import annotations
 import gc
 import logging
 import os
+import signal
 import sys
 
 import panel as pn
@@ -210,4 +211,12 @@ def serve(port: int = 5006, address: str = "localhost", show: bool = False,
     print(f"Bushing Explorer: http://{host}:{server.port}/", flush=True)
     sys.stdout.flush()
     server.start()
-    server.io_loop.start()
+    # SIGTERM (a container's or a service manager's stop) ends the loop as Ctrl-C does, as `bokeh
+    # serve` has it: serve returns and the worker processes stop. By default it killed the process
+    # and left the workers' forkserver and worker running, orphaned (the worker holds the pipe by
+    # which the forkserver would see its parent gone)
+    server.io_loop.asyncio_loop.add_signal_handler(signal.SIGTERM, server.io_loop.stop)
+    try:
+        server.io_loop.start()
+    finally:
+        work.stop_processes()

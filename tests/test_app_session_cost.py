@@ -138,7 +138,9 @@ def test_the_server_freezes_what_it_holds_before_its_first_session(monkeypatch):
         def start(self):
             frozen.append(gc.get_freeze_count())
 
-        io_loop = type("Loop", (), {"start": staticmethod(lambda: None)})()
+        io_loop = type("Loop", (), {"start": staticmethod(lambda: None), "stop": staticmethod(lambda: None),
+                                    "asyncio_loop": type("Asyncio", (), {"add_signal_handler": staticmethod(
+                                        lambda *a: None)})()})()
 
     monkeypatch.setattr(pn, "serve", lambda *a, **k: Server())
     monkeypatch.setattr(main.work, "use_processes", lambda: None)

@@ -258,3 +258,60 @@ def test_card_and_export_give_each_direction_the_stiffness_of_its_design_file(sh
     else:  # eq 18's closed form: 3.5 % stiffer than the finite-length table for Paper B
         assert expected["axial"] == pytest.approx(stiffness(PAPER_B, [10.0], [1e-4]).magnitude[0, 0], rel=1e-10)
         assert expected["axial"] > 1.03 * table
+
+
+def _descendants(pid: int) -> set[int]:
+    """The processes under ``pid`` (Linux /proc), its children's children included."""
+    parents = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                stat = (entry / "stat").read_text()
+            except OSError:
+                continue
+            parents[int(entry.name)] = int(stat.rsplit(")", 1)[1].split()[1])
+    found, todo = set(), [pid]
+    while todo:
+        parent = todo.pop()
+        for child, ppid in parents.items():
+            if ppid == parent and child not in found:
+                found.add(child)
+                todo.append(child)
+    return found
+
+
+def _running(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads the process table from /proc")
+def test_serve_stops_with_its_worker_processes_on_sigterm():
+    """SIGTERM (a container's or a service manager's stop) ends `bushing serve` with status 0, and
+    its worker processes (the diagnosis' forkserver, worker and resource tracker) end with it:
+    SIGTERM used to kill the server alone and leave them running, orphaned, at every stop."""
+    import signal
+    import time
+
+    proc = subprocess.Popen([sys.executable, "-m", "cli.main", "serve", "--port", "0"],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    try:
+        found = re.fullmatch(r"Bushing Explorer: http://localhost:(\d+)/", proc.stdout.readline().strip())
+        assert found, "no URL printed"
+        assert b"Bushing Explorer" in fetch(f"http://localhost:{found.group(1)}/")
+        workers = _descendants(proc.pid)
+        assert workers  # the diagnosis' worker processes, started with the server
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(60) == 0
+        for _ in range(600):  # bounded by count: at most about 60 s
+            if not any(_running(p) for p in workers):
+                break
+            time.sleep(0.1)
+        assert not [p for p in workers if _running(p)]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(10)
+        proc.stdout.close()
