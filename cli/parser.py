@@ -11,7 +11,7 @@ from core.element import DEFAULT_BAND
 from core.element.coefficients import MAX_SLICES as ELEMENT_SLICES
 from core.element.prony import MAX_DECADES as MAX_BAND_DECADES
 from core.io.export import FORMATS
-from core.parameters import BRANCH_PARAMETERS, MODE, ROTATIONS, TRANSLATIONS
+from core.parameters import BRANCH_PARAMETERS, FREQUENCY_HZ, MODE, ROTATIONS, TRANSLATIONS
 from core.rules import OVERFLOW, WHOLE, RuleError, decimal, excerpt
 
 NUMBER_FORMAT = "{:.12g}"
@@ -53,15 +53,13 @@ def _positive(name):
 
 
 def _frequency(name):
-    """A positive number of Hz within the frequencies a measured file may hold
-    (:data:`core.io.measured.MEASURED_FREQUENCY_HZ`): the range the model is meant for."""
-    from core.io.measured import MEASURED_FREQUENCY_HZ
-
+    """A positive number of Hz within the frequencies any file may hold
+    (:data:`core.parameters.FREQUENCY_HZ`): the range the model is meant for."""
     positive = _positive(name)
 
     def parse(text: str) -> float:
         value = positive(text)
-        lo, hi = MEASURED_FREQUENCY_HZ
+        lo, hi = FREQUENCY_HZ
         if not lo <= value <= hi:
             raise argparse.ArgumentTypeError(f"{name} must be within {lo:g}–{hi:g} Hz (a rubber bushing's "
                                              f"frequencies, as measured files hold), got {excerpt(repr(text))}")

@@ -201,6 +201,9 @@ MODE_TABLE: tuple[Mode, ...] = (
 )
 MODE = {m.name: m for m in MODE_TABLE}
 MODES = tuple(MODE)
+# every frequency a file or the command line gives (measured data, targets, --freq): from
+# creep-like tests to the acoustic range; beyond, the time base or the units are wrong
+FREQUENCY_HZ = (1e-4, 1e5)
 SHAPES = ("long", "finite")  # closed forms of long bushings, or the finite-length table
 # the design file's words for them (docs/files.md): "thesis" names the thesis' closed forms, axial
 # (eq 18) and torsion (eq 17) only; "long", this project's earlier word for every long-bushing

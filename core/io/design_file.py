@@ -77,8 +77,8 @@ def design_from_dict(data: Any) -> Design:
     shape = data.get("shape")
     if shape is not None and (not isinstance(shape, str) or shape not in SHAPE_FROM_FILE):
         raise DesignError("shape", f"must be one of {', '.join(FILE_SHAPE.values())}, got {excerpt(repr(shape))}", BAD_CHOICE)
-    if shape == "thesis" and thesis_shape_refused(data["mode"]):
-        raise DesignError("shape", thesis_shape_refused(data["mode"]), BAD_CHOICE)
+    if shape == "thesis" and (refused := thesis_shape_refused(data["mode"])):
+        raise DesignError("shape", refused, BAD_CHOICE)
     material = Material(**data["material"])
     check_bulk_ratio(material)
     return Design(

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..data import STIFFNESS_RANGE, DataError, MeasuredLoop, MeasuredStiffness
 from ..numbers import format_number, format_outside
-from ..parameters import MODES
+from ..parameters import FREQUENCY_HZ, MODES
 from ..response import loss_factor
 from ..rules import (
     BAD_CHOICE,
@@ -45,9 +45,7 @@ from ..rules import (
 
 MAX_BYTES = 20 * 1024 * 1024
 MAX_ROWS = 200_000
-# measured frequencies: from creep-like tests to the acoustic range; beyond, the time base or
-# the units are wrong
-MEASURED_FREQUENCY_HZ = (1e-4, 1e5)
+MEASURED_FREQUENCY_HZ = FREQUENCY_HZ  # measured frequencies: the table's (core.parameters)
 # a loop's drive must be a steady sine: the RMS departure from the best sine, relative to its
 # amplitude, is at most this
 LOOP_SINE_DEPARTURE = 0.1

@@ -13,7 +13,7 @@ from typing import Any
 
 from ..bushing import stiffness_points
 from ..design import Design
-from ..parameters import GEOMETRY, MATERIAL, MODE, MODES
+from ..parameters import FREQUENCY_HZ, GEOMETRY, MATERIAL, MODE, MODES
 from ..parts import SIZE_RANGE
 from ..registry import parameter
 from ..rules import (
@@ -41,7 +41,6 @@ DEFAULT_LIMITS = {"inner_radius": (1e-3, 1.0), "outer_radius": (2e-3, 1.0), "len
                   "thickness": (1e-3, 1.0)}
 TOLERANCE = 0.01  # a numeric target is met within ±1 % unless the file says otherwise
 MAX_TARGETS, MAX_SOLUTIONS = 20, 10
-FREQUENCY_RANGE = (1e-4, 1e5)
 MAX_FILE_BYTES = 1_000_000
 _FILE_KEYS = ("design", "targets", "tolerance", "limits", "free_material", "fixed", "solutions")
 _WORDS = input_file_words("targets")
@@ -94,8 +93,8 @@ def _target(i: int, spec: Any, tolerance: float, start: Design) -> Target:
     if "ratio" in spec and modes[0] == modes[1]:
         raise TargetError(f"{key}.ratio", "two different modes", BAD_CHOICE)
     f = _number(f"{key}.frequency_hz", spec.get("frequency_hz"))
-    if not FREQUENCY_RANGE[0] <= f <= FREQUENCY_RANGE[1]:
-        raise TargetError(f"{key}.frequency_hz", f"from {FREQUENCY_RANGE[0]:g} to {FREQUENCY_RANGE[1]:g} Hz, got {f:g}",
+    if not FREQUENCY_HZ[0] <= f <= FREQUENCY_HZ[1]:
+        raise TargetError(f"{key}.frequency_hz", f"from {FREQUENCY_HZ[0]:g} to {FREQUENCY_HZ[1]:g} Hz, got {f:g}",
                           OUT_OF_RANGE)
     if "amplitudes" in spec:
         amps = spec["amplitudes"]
