@@ -37,7 +37,7 @@ def test_the_busy_page_escapes_its_reason_and_reloads_itself():
 
 
 def test_the_routes_replaced_were_panels():
-    """The one library internal behind admission (app/patches.py): Bokeh's server reads its
+    """The one library internal behind admission (app/patches/): Bokeh's server reads its
     per-app routes from this module list, which holds Panel's handlers."""
     from bokeh.server import urls
     from panel.io.server import DocHandler, WSHandler

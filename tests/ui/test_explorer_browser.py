@@ -244,7 +244,7 @@ def same_box(shown, expected):
 
 
 def test_bokehjs_paint_patches_keep_bokehs_behaviour(page, explorer_url):
-    """The three BokehJS patches of app/patches.py are active, and what they change still behaves
+    """The three BokehJS patches of app/patches/ are active, and what they change still behaves
     as Bokeh's own code: glyph elements sit on their data's box, CSS theming still applies."""
     open_explorer(page, explorer_url)
     assert page.evaluate("() => [window.bushingStyleWrites, window.bushingCssReads, window.bushingGlyphPosition]") \
