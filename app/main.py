@@ -152,6 +152,7 @@ class App(pn.viewable.Viewer):
             sidebar_width=380,
             header_background="#1f5f8b",
             busy_indicator=None,  # its animation restyled the page on every change
+            design=patches.PageDesign,  # every component styled alike, however late it is built
         )
         return template
 

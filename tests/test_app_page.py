@@ -390,3 +390,50 @@ def test_holoviews_makes_no_selection_glyph_model_where_no_selection_style(monke
     assert [(type(g).__name__, g.line_color) for g in styled] == [("Line", "red")]
     monkeypatch.setattr(ElementPlot, "_update_glyph", ours.original)
     assert [type(g).__name__ for g in selection_glyphs(hv.Curve([1, 3, 2]))] == ["Line"]
+
+
+def _sheet_names(sheets) -> list[str]:
+    return [getattr(s, "url", None) or str(s)[:60] for s in sheets]
+
+
+def test_the_page_design_styles_a_component_as_a_part_of_the_page():
+    """Panel's Bootstrap design styles a component asked for alone (``Design.params``: Panel asks so
+    for a model made after the page was built, and at every text change of an HTML pane) with
+    Bootstrap's whole stylesheet and the theme's; the page's design (:class:`app.patches.PageDesign`)
+    gives the stylesheets the template gives the same component at page build."""
+    import panel as pn
+    from panel.theme import Bootstrap
+
+    from app import patches
+
+    assert patches.PATCHED
+    pane = pn.pane.HTML("x")
+    alone = _sheet_names(Bootstrap().params(pane)[0]["stylesheets"])
+    assert any("bootstrap.min.css" in n for n in alone)  # Panel's own: what the patch is for
+    ours = _sheet_names(patches.PageDesign().params(pane)[0]["stylesheets"])
+    modifiers, _children = Bootstrap._get_modifiers(pane, Bootstrap().theme, isolated=False)
+    assert ours == [str(s) for s in modifiers["stylesheets"]]
+    assert not any("bootstrap.min.css" in n or "default.css" in n for n in ours)
+
+
+def test_no_component_of_a_page_carries_bootstraps_whole_stylesheet():
+    """A served page, its lazily built *Find the missing effect* tab opened and its texts changed (data
+    loaded): no model of the page has Bootstrap's whole stylesheet (36 had it after a diagnosis, each
+    in its own shadow root, and Chromium weighed its rules at every stylesheet change of the page)."""
+    from panel.io.state import set_curdoc
+
+    from app.tabs.find_the_missing_effect import DiagnosisView
+    from core.synthetic import synthetic_stiffness
+
+    app = App()
+    doc = rendered(app.template())
+
+    with set_curdoc(doc):
+        app.tabs.active = 1 + [title for title, _name, _build in App.LAZY_TABS].index("Find the missing effect")
+        view = app.view("diagnosis")
+        assert isinstance(view, DiagnosisView)
+        data = synthetic_stiffness(PAPER_B, np.linspace(1, 100, 5), [1e-4, 3e-4], noise=0.0, seed=1)
+        view.state.load_csv(data.to_csv())
+    sheets = [n for m in doc.models if hasattr(m, "stylesheets") for n in _sheet_names(m.stylesheets)]
+    assert len(sheets) > 100  # the page's components and their stylesheets are there
+    assert not [n for n in sheets if "bootstrap.min.css" in n]

@@ -39,3 +39,25 @@ def test_the_reports_plots_come_with_the_data_and_the_report_adds_no_model(page,
     shown = plots(page)
     assert shown[GAP]["points"] == 2 and len(shown[GAP]["spans"]) == 1  # the bars, the noise line
     assert shown["Final: |K| misfit (%)"]["points"] >= 150
+
+
+# the shadow roots of the page whose stylesheets include Bootstrap's whole stylesheet
+BOOTSTRAP_ROOTS_JS = """() => {
+  const roots = [];
+  const walk = (node) => { for (const el of node.querySelectorAll('*')) if (el.shadowRoot) { roots.push(el.shadowRoot); walk(el.shadowRoot); } };
+  walk(document);
+  return {roots: roots.length, bootstrap: roots.filter(r => [...r.children].some(c => c.tagName === 'LINK' && /bootstrap\\.min\\.css/.test(c.href))).length};
+}"""
+
+
+def test_after_a_diagnosis_no_component_carries_bootstraps_whole_stylesheet(page, explorer_url, tmp_path):
+    """Every component of the page is styled as a part of it (app.patches.PageDesign): after a
+    diagnosis, none of the page's shadow roots holds Bootstrap's whole stylesheet (36 did on
+    ddcd59e, each weighed by Chromium at every stylesheet change of the page)."""
+    open_explorer(page, explorer_url)
+    upload_150_points(page, tmp_path)
+    page.get_by_role("button", name="Diagnose").click()
+    page.get_by_text("What is left is noise", exact=True).wait_for(timeout=120_000)
+    wait_plot(page, GAP, "p.points === 2")
+    found = page.evaluate(BOOTSTRAP_ROOTS_JS)
+    assert found["roots"] > 100 and found["bootstrap"] == 0, found
