@@ -163,6 +163,7 @@ class App(pn.viewable.Viewer):
 def create_app():
     """Factory for one session (served per connection, so sessions never share state)."""
     patches.install(pn.state.curdoc)  # the library hooks (once) and the page's BokehJS patches
+    work.quiet_closed_writes()  # a page that closes while a message is written to it: nothing logged
     app = App()
     app.sync_url()
     return app.template()

@@ -9,7 +9,10 @@ without its result.
 
 A page closed during the work: its session's connection is gone, or the session discarded. Then
 nothing more is written to its document (:func:`page_open`): no progress, no result. A write to
-a socket that has closed is what logged ``WebSocketClosedError`` (issue #27, item 15).
+a socket that has closed is what logged ``WebSocketClosedError`` (issue #27, item 15). A page can
+still close while a message is being written to it (a group of the report's plots made while the
+work runs, half a second of the event loop during which the page's close is not read): the
+failed writes then go nowhere, quietly (:func:`quiet_closed_writes`).
 
 No Panel import: the states (:mod:`app.targets_form`) use it too; the views pass the document.
 
@@ -33,7 +36,7 @@ import logging
 import multiprocessing
 import os
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
@@ -44,6 +47,10 @@ import numpy as np
 log = logging.getLogger("bushing.app")
 
 PROGRESS_POLL_S = 0.15  # s between two progress updates on the page
+# s before each step done on the event loop while the work runs (in_thread's ``meanwhile``): the
+# loop writes the page's messages meanwhile (the progress set at a click can wait for the server's
+# answer to the click to be written first: a few turns of the loop, measured 10-25 ms)
+STEP_GAP_S = 0.03
 
 Say = Callable[[float, str], None]
 
@@ -167,6 +174,40 @@ class PageClosed(Exception):
     """The page that asked for the work closed before it ended."""
 
 
+def _unretrieved_closed_write(context: dict) -> bool:
+    """Whether an event loop's error ``context`` is a failed write to a websocket that closed,
+    which nobody awaited (Panel writes a message's parts as separate futures, and drops them
+    when one fails)."""
+    from tornado.websocket import WebSocketClosedError
+
+    return isinstance(context.get("exception"), WebSocketClosedError) and "never retrieved" in context.get("message", "")
+
+
+def quiet_closed_writes(loop: asyncio.AbstractEventLoop | None = None) -> None:
+    """The event loop (the running one if None) says nothing of a write to a page that has gone
+    and that nobody awaited (:func:`_unretrieved_closed_write`): the message was for nobody.
+    Every other error goes to the handler it had (asyncio's own by default). Once per loop."""
+    if loop is None:
+        try:
+            loop = asyncio.get_running_loop()
+        except RuntimeError:
+            return  # no event loop runs (a script, a test building a page): nothing is served
+    previous = loop.get_exception_handler()
+    if getattr(previous, "quiet_closed_writes", False):
+        return
+
+    def handler(loop, context):
+        if _unretrieved_closed_write(context):
+            log.debug("a message to a closed page went nowhere: %s", context.get("message"))
+        elif previous is not None:
+            previous(loop, context)
+        else:
+            loop.default_exception_handler(context)
+
+    handler.quiet_closed_writes = True
+    loop.set_exception_handler(handler)
+
+
 def page_open(doc) -> bool:
     """Whether the Bokeh document ``doc`` still has a page to write to: no document or no server
     session (a script, a test without a server) counts as open."""
@@ -178,24 +219,36 @@ def page_open(doc) -> bool:
 
 
 async def in_thread(work: Callable[[Say], Any], show: Callable[[float, str], None] | None = None,
-                    doc=None) -> Any:
+                    doc=None, meanwhile: Iterable[Callable[[], None]] = ()) -> Any:
     """``work(say)`` in a worker thread (a :class:`Task` in a worker process when they are on:
     :func:`use_processes`); while it runs, ``show(fraction, message)`` on the event
     loop with the latest ``say`` (fraction clipped to 0–1), only while the page is open and the
     work is not finishing (a fraction of 1: its result comes next, in the caller's push).
     Returns what ``work`` returns, raises what it raises; :class:`PageClosed` if the page closed
     meanwhile (the result would go nowhere). ``doc``: the page's Bokeh document (``pn.state.curdoc``
-    in the view that asks)."""
+    in the view that asks).
+
+    ``meanwhile``: steps for the event loop while the work runs in its worker process (the server's
+    other core), each called once the work has started, :data:`STEP_GAP_S` after the previous one
+    (the loop writes and reads the page's messages between two steps: what the caller set before
+    this call reaches the page before the first step), only while the work runs and the page is
+    open. Those left when the work ends or the page closes are not called."""
     latest: list = []  # written by the worker, read here on the event loop
     task, task_id = _submit(work, latest)
+    steps = list(meanwhile)
     try:
         shown = None
         while not task.done():
-            await asyncio.wait({task}, timeout=PROGRESS_POLL_S)
+            await asyncio.wait({task}, timeout=STEP_GAP_S if steps else PROGRESS_POLL_S)
             if (show is not None and latest and latest != shown and latest[0] < 1.0 and not task.done()
                     and page_open(doc)):
                 shown = list(latest)
                 show(float(np.clip(shown[0], 0.0, 1.0)), str(shown[1]))
+            if steps and not task.done():
+                if page_open(doc):
+                    steps.pop(0)()
+                else:
+                    steps.clear()
     finally:
         _progress.pop(task_id, None)
     if not page_open(doc):

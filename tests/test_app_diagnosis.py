@@ -175,3 +175,46 @@ def test_data_of_two_modes_are_diagnosed_jointly_and_plotted_in_the_explorers_mo
     assert app.state.design.mode == "torsion" and app.state.design.effect_parameters == {}
     app.state.mode = "axial"  # on its own rig the mass acts
     assert app.state.design.effect_parameters["inertia"]["mass"] == pytest.approx(r.steps[0].parameters["mass"])
+
+
+def test_the_click_starts_the_work_then_makes_the_plots_not_ready_while_it_runs(app, monkeypatch):
+    """Diagnose clicked before the report's plots were made ready for the data (on a served page
+    they are made one group at a time after the data are shown): the work is started first, and
+    the groups left are made while it runs (the work waits here until they are), then the report
+    is written into them. On 5d78637 the click made them before it started the work."""
+    import threading
+
+    from app import work
+    from app.diagnosis_state import DiagnosisState
+    from app.tabs.find_the_missing_effect import PLOT_GROUPS, DiagnosisView
+
+    order, made = [], threading.Event()
+    submit, prepare, task = work._submit, DiagnosisView._prepare, DiagnosisState.task
+
+    def submitted(job, latest):
+        order.append("work started")
+        return submit(job, latest)
+
+    def prepared(self, name):
+        prepare(self, name)
+        order.append(name)
+        made.set() if self._ready == set(PLOT_GROUPS) else None
+
+    def waits_for_the_plots(self):
+        t = task(self)
+
+        def function(*args, **kwargs):
+            assert made.wait(60), "the plots were not made while the work ran"
+            return t.function(*args, **kwargs)
+
+        return work.Task(function, t.args, t.kwargs)
+
+    monkeypatch.setattr(work, "_submit", submitted)
+    monkeypatch.setattr(DiagnosisView, "_prepare", prepared)
+    monkeypatch.setattr(DiagnosisState, "task", waits_for_the_plots)
+    monkeypatch.setattr(DiagnosisView, "_on_data", lambda self, *_e: setattr(self, "_ready", set()))
+    view = app.diagnosis
+    view.state.load_csv(inertia_csv())
+    run(app)
+    assert order == ["work started", *PLOT_GROUPS]
+    assert "What is left is noise" in view.report.object and set(view.live) == set(PLOT_GROUPS)

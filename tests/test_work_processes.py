@@ -65,3 +65,26 @@ def test_an_error_in_a_worker_is_the_works_own(processes):
 
 def test_without_processes_a_task_runs_in_a_thread():
     assert run(work.Task(pid_of)) == os.getpid()
+
+
+def test_a_write_to_a_closed_page_that_nobody_awaited_is_not_logged(caplog):
+    """The event loop of a served explorer says nothing of a failed write to a page that has gone
+    (app.work.quiet_closed_writes); any other error goes to asyncio's own handler, logged."""
+    from tornado.websocket import WebSocketClosedError
+
+    loop = asyncio.new_event_loop()
+    try:
+        work.quiet_closed_writes(loop)
+        work.quiet_closed_writes(loop)  # once per loop
+        with caplog.at_level("DEBUG", logger="asyncio"):
+            loop.call_exception_handler({"message": "Task exception was never retrieved",
+                                         "exception": WebSocketClosedError()})
+            assert [r for r in caplog.records if r.name == "asyncio"] == []
+            loop.call_exception_handler({"message": "Task exception was never retrieved",
+                                         "exception": ValueError("a bug")})
+            loop.call_exception_handler({"message": "socket.send() raised exception.",
+                                         "exception": WebSocketClosedError()})
+        logged = [r for r in caplog.records if r.name == "asyncio"]
+        assert [r.levelname for r in logged] == ["ERROR", "ERROR"]
+    finally:
+        loop.close()

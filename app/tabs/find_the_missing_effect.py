@@ -3,9 +3,9 @@
 
 from __future__ import annotations
 
-import asyncio
 import io
 import logging
+from functools import partial
 
 import numpy as np
 import panel as pn
@@ -79,7 +79,7 @@ class DiagnosisView(pn.viewable.Viewer):
                                                                variant="outline")
         self.run = pn.widgets.Button(label="Diagnose", color="primary",
                                      description=tip("Fit the baseline and every candidate effect; name what is missing."))
-        self.run.on_click(self._run)
+        self.run.on_click(self._click)
         # the progress (a bar and the step) in the text of one pane of a fixed height beside the
         # button: a widget shown and hidden, a button's state changed or the page's height changed
         # lays the whole page out again in the browser (30–100 ms each, Chromium's profiler), at
@@ -129,22 +129,37 @@ class DiagnosisView(pn.viewable.Viewer):
 
     # ---- events --------------------------------------------------------------------------------
 
-    async def _run(self, _event):
-        """The diagnosis in a worker thread, its steps shown as they come (:func:`app.work.in_thread`);
-        the report and its plots replace the progress in one push. A page closed meanwhile gets
-        nothing more."""
+    def _click(self, _event):
+        """A click on *Diagnose*: its progress set as the click is handled (on a served page it is
+        written then, at once, before anything else is done), then the work (:meth:`_diagnose`).
+        A click while it runs is ignored."""
+        if self._begin():
+            pn.state.execute(self._diagnose)
+
+    async def _run(self, _event=None):
+        """:meth:`_click`, the work awaited (scripts, tests)."""
+        if self._begin():
+            await self._diagnose()
+
+    def _begin(self) -> bool:
+        """The progress set for a diagnosis; False if one runs already."""
+        if self.state.running:
+            return False
+        self.state.param.update(running=True, message="", result=None, revealed=False, progress=0.0,
+                                progress_message="fitting the baseline")
+        return True
+
+    async def _diagnose(self):
+        """The diagnosis in a worker process (a thread in an unserved app), its steps shown as they
+        come (:func:`app.work.in_thread`); the report and its plots replace the progress in one
+        push. The groups of plots not yet made ready for the data (a click as soon as they are
+        shown) are made on the server while the work runs, the work started first: measured with
+        ``benchmarks/diagnose_browser.py``, making them before the work (5d78637) added their 0.9 s
+        of the server's CPU to the wait. A page closed meanwhile gets nothing more."""
         state = self.state
-        if state.running:
-            return
-        state.param.update(running=True, message="", result=None, revealed=False, progress=0.0,
-                           progress_message="fitting the baseline")
-        await asyncio.sleep(0)  # the progress goes to the page first
-        if self._ready != set(PLOT_GROUPS):  # then the groups of plots not yet made ready, before the
-            for name in PLOT_GROUPS:  # work, and their messages written (a page closed while one is
-                self._prepare(name)  # written logged an unretrieved WebSocketClosedError)
-            await asyncio.sleep(PREPARE_GAP_MS / 1000)
+        unready = [partial(self._prepare, name) for name in PLOT_GROUPS if name not in self._ready]
         try:  # in a worker process when the server has them (app.work.use_processes)
-            result = await in_thread(state.task(), self._show_progress, pn.state.curdoc)
+            result = await in_thread(state.task(), self._show_progress, pn.state.curdoc, meanwhile=unready)
         except PageClosed:
             return  # nothing is written to a closed page's document, not even "running" ended
         except (ValueError, ConvergenceError) as exc:
@@ -172,7 +187,7 @@ class DiagnosisView(pn.viewable.Viewer):
         """New data: the report's plots are made ready for them once the data are on the page
         (:meth:`_prepare`; on a served page the data's message goes first, then one group of
         plots every :data:`PREPARE_GAP_MS`, so that a click on *Diagnose* waits for one group at
-        most; the click makes the groups left, after its progress is shown: :meth:`_run`)."""
+        most; the groups left are made while the diagnosis runs: :meth:`_diagnose`)."""
         self._prepared += 1
         self._ready, self._overlays = set(), None
         generation, doc = self._prepared, pn.state.curdoc
@@ -248,7 +263,7 @@ class DiagnosisView(pn.viewable.Viewer):
                                   f"{format_value(d.frequency_hz.max(), 'Hz', 'frequency')}; {'; '.join(per_mode)}.")
         else:
             self.source.object = "_No data loaded yet._"
-        self.run.disabled = s.data is None  # a click while it runs is ignored (_run)
+        self.run.disabled = s.data is None  # a click while it runs is ignored (_click)
         self._on_progress()
         r = s.result
         self._results.visible = r is not None
