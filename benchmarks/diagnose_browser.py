@@ -37,6 +37,7 @@ sys.path.insert(0, str(HERE))
 from servers import start_explorer  # the same server start, its printed URL
 
 TARGET_S = 2.0
+POLL_MS = 100  # how often the benchmark asks the page whether the report is drawn
 CHROMIUM = "/usr/bin/chromium"
 
 # in the page: watch the document from the click on; the report's arrival and what came before.
@@ -112,16 +113,18 @@ def measure(page, url: str, csv: Path, pause: float = 0.0) -> dict:
     start = metrics(cdp)
     page.evaluate(WATCH_JS)
     page.get_by_role("button", name="Diagnose").click()
-    page.wait_for_function("() => window.bushingSeen.report !== null", timeout=120_000)
-    page.wait_for_function(DRAWN_JS, arg=GAP_TITLE, timeout=120_000)
-    drawn = page.evaluate("() => performance.now() - window.bushingSeen.t0")
+    # polled every 100 ms, not at every frame (Playwright's default): a poll per frame keeps the
+    # page drawing a frame every 16 ms, measured 0.7 s of Chromium's compositor over one wait, on
+    # the cores the server and its worker need; the times are the page's own (the watcher's)
+    page.wait_for_function("() => window.bushingSeen.report !== null && window.bushingSeen.painted != null",
+                           timeout=120_000, polling=POLL_MS)
     seen = page.evaluate("() => window.bushingSeen")
     end = metrics(cdp)
     cdp.detach()
-    return {"report": drawn / 1000, "progress": None if seen["progress"] is None else seen["progress"] / 1000,
+    return {"report": max(seen["report"], seen["painted"]) / 1000,
+            "progress": None if seen["progress"] is None else seen["progress"] / 1000,
             "done_alone": seen["doneAlone"], "page": {k: end[k] - start[k] for k in BROWSER_WORK},
-            "push_to_paint": (page.wait_for_function("() => window.bushingSeen.painted != null").json_value()
-                              and page.evaluate("() => (window.bushingSeen.painted - window.bushingSeen.pushed) / 1000"))}
+            "push_to_paint": (seen["painted"] - seen["pushed"]) / 1000}
 
 
 # the page's own work (Chromium's Performance domain, seconds): scripts, layout, style recalculation
