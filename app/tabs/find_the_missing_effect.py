@@ -54,9 +54,13 @@ def effect_units(effect: str, mode: str) -> dict[str, str]:
 
 PLOT_GROUPS = ("gap", "curves", "maps")  # the report's plots, in the order the page shows them
 PLOT_COLUMNS = {"gap": 1, "curves": 2, "maps": 2}
-# between two groups of plots made ready (a served page): the event loop reads the page's messages
-# meanwhile, so that a click on *Diagnose* waits for the group being built, not for every group
-# (a next-tick chain let the three groups run before the click's message was read: 1.4 s)
+PLOT_COUNTS = {"gap": 1, "curves": 2, "maps": 4}  # plots per group
+# the plots made ready one at a time, in the page's order: (group, index in it)
+PREPARE_STEPS = tuple((name, i) for name in PLOT_GROUPS for i in range(PLOT_COUNTS[name]))
+# between two plots made ready (a served page): the event loop reads the page's messages
+# meanwhile, so that a click on *Diagnose* waits for the plot being built, not for every plot
+# (a next-tick chain let them all run before the click's message was read: 1.4 s; a group at a
+# time, the click waited up to 0.9 s for the two curves)
 PREPARE_GAP_MS = 30
 PROGRESS_HEIGHT = 44  # px: the progress' box, beside the Diagnose button
 
@@ -102,11 +106,16 @@ class DiagnosisView(pn.viewable.Viewer):
         self.download_predictions = pn.widgets.FileDownload(
             callback=lambda: io.StringIO(state.predictions_csv()), filename="bushing-predictions.csv",
             label="Predictions (CSV)")
-        self.live: dict[str, LivePlot] = {}  # "gap", "curves", "maps": built with the first result
+        self.live: dict[str, LivePlot] = {}  # "gap", "curves", "maps": built with the first data
         self._prepared = 0  # how many data sets the plots were made ready for: a newer one stops an older
-        self._ready: set[str] = set()  # the groups of plots made ready for the loaded data
+        self._ready: set[tuple[str, int]] = set()  # the plots made ready for the loaded data (PREPARE_STEPS)
         self._overlays: dict | None = None  # what they were made with (_pending)
-        self._plot_holders = {name: pn.Column(sizing_mode="stretch_width") for name in ("gap", "curves", "maps")}
+        self._shown: dict[str, dict] = {}  # the overlays each group's LivePlot was last given
+        # a place in the page for each plot, filled when the plot is first made (the grid never changes)
+        self._slots = {name: [pn.Column(sizing_mode="stretch_width") for _ in range(PLOT_COUNTS[name])]
+                       for name in PLOT_GROUPS}
+        self._plot_holders = {name: pn.GridBox(*self._slots[name], ncols=PLOT_COLUMNS[name], sizing_mode="stretch_width")
+                              for name in PLOT_GROUPS}
         self._results = pn.Column(
             "### 3. What the diagnosis found",
             self.report,
@@ -153,11 +162,11 @@ class DiagnosisView(pn.viewable.Viewer):
         """The diagnosis in a worker process (a thread in an unserved app), its steps shown as they
         come (:func:`app.work.in_thread`); the report and its plots replace the progress in one
         push. The groups of plots not yet made ready for the data (a click as soon as they are
-        shown) are made on the server while the work runs, the work started first: measured with
-        ``benchmarks/diagnose_browser.py``, making them before the work (5d78637) added their 0.9 s
-        of the server's CPU to the wait. A page closed meanwhile gets nothing more."""
+        shown) are made on the server while the work runs, one at a time, the work started first:
+        measured with ``benchmarks/diagnose_browser.py``, making them before the work (5d78637)
+        added their 0.9 s of the server's CPU to the wait. A page closed meanwhile gets nothing more."""
         state = self.state
-        unready = [partial(self._prepare, name) for name in PLOT_GROUPS if name not in self._ready]
+        unready = [partial(self._prepare, *step) for step in PREPARE_STEPS if step not in self._ready]
         try:  # in a worker process when the server has them (app.work.use_processes)
             result = await in_thread(state.task(), self._show_progress, pn.state.curdoc, meanwhile=unready)
         except PageClosed:
@@ -185,9 +194,9 @@ class DiagnosisView(pn.viewable.Viewer):
 
     def _on_data(self, *_events):
         """New data: the report's plots are made ready for them once the data are on the page
-        (:meth:`_prepare`; on a served page the data's message goes first, then one group of
-        plots every :data:`PREPARE_GAP_MS`, so that a click on *Diagnose* waits for one group at
-        most; the groups left are made while the diagnosis runs: :meth:`_diagnose`)."""
+        (:meth:`_prepare`; on a served page the data's message goes first, then one plot every
+        :data:`PREPARE_GAP_MS`, so that a click on *Diagnose* waits for one plot at most; the
+        plots left are made while the diagnosis runs: :meth:`_diagnose`)."""
         self._prepared += 1
         self._ready, self._overlays = set(), None
         generation, doc = self._prepared, pn.state.curdoc
@@ -195,10 +204,10 @@ class DiagnosisView(pn.viewable.Viewer):
 
         def prepare(i: int):
             s = self.state
-            if (generation != self._prepared or i >= len(PLOT_GROUPS) or s.running or s.result is not None
+            if (generation != self._prepared or i >= len(PREPARE_STEPS) or s.running or s.result is not None
                     or not page_open(doc)):
-                return  # newer data came, every group is made, the click makes the rest, or the page closed
-            self._prepare(PLOT_GROUPS[i])
+                return  # newer data came, every plot is made, the click makes the rest, or the page closed
+            self._prepare(*PREPARE_STEPS[i])
             if served:
                 doc.add_timeout_callback(lambda: prepare(i + 1), PREPARE_GAP_MS)
             else:
@@ -209,16 +218,17 @@ class DiagnosisView(pn.viewable.Viewer):
         else:
             prepare(0)
 
-    def _prepare(self, name: str):
-        """The group ``name`` of the report's plots made ready for the loaded data, once."""
-        if name in self._ready:
+    def _prepare(self, name: str, index: int):
+        """The plot ``index`` of the group ``name`` of the report's plots made ready for the loaded
+        data, once (the group's plots before it too)."""
+        if (name, index) in self._ready:
             return
         if self._overlays is None:
             self._overlays = self._pending()
             if self._overlays is None:
                 return
-        update_or_keep("DiagnosisView prepared no plots", lambda: self._plot(name, self._overlays))
-        self._ready.add(name)
+        update_or_keep("DiagnosisView prepared no plots", lambda: self._plot(name, self._overlays, index + 1))
+        self._ready.update((name, i) for i in range(index + 1))
 
     def _pending(self) -> dict | None:
         """The report's plots with the shape a diagnosis of the loaded data will give them
@@ -237,14 +247,18 @@ class DiagnosisView(pn.viewable.Viewer):
         for name in PLOT_GROUPS:
             self._plot(name, overlays)
 
-    def _plot(self, name: str, overlays: dict):
-        """The group ``name`` of the report's plots showing ``overlays[name]``, built the first time."""
+    def _plot(self, name: str, overlays: dict, count: int | None = None):
+        """The group ``name`` of the report's plots showing ``overlays[name]``, its first ``count``
+        plots (all if None) in their places on the page: each built by HoloViews when first put there."""
         live = self.live.get(name)
         if live is None:
             self.live[name] = live = LivePlot(overlays[name])
-            self._plot_holders[name].objects = [live.grid(PLOT_COLUMNS[name])]
-        else:
+        elif self._shown.get(name) is not overlays:
             live.show(overlays[name])
+        self._shown[name] = overlays
+        for slot, pane in zip(self._slots[name][:count], live.panes):
+            if not slot.objects:
+                slot.objects = [pane]
 
     # ---- refresh -------------------------------------------------------------------------------
 
