@@ -136,6 +136,7 @@ POINT_JS = """([title, label, k]) => {
   const legend = [...fig.center, ...fig.right, ...fig.left, ...fig.above, ...fig.below].find(m => m.type === 'Legend');
   const r = legend.items.find(it => (it.label.value || it.label.field) === label).renderers[0];
   const data = r.data_source.data, xs = data[r.glyph.x.field], ys = data[r.glyph.y.field];
+  view.canvas_view.el.scrollIntoView({block: "center"});  // a plot below the window's edge: scrolled to, as a user would
   const i = Math.floor(xs.length * k), box = view.canvas_view.el.getBoundingClientRect();
   return [box.left + view.frame.x_scale.compute(xs[i]), box.top + view.frame.y_scale.compute(ys[i])];
 }"""
