@@ -161,7 +161,7 @@ class DiagnosisView(pn.viewable.Viewer):
     async def _diagnose(self):
         """The diagnosis in a worker process (a thread in an unserved app), its steps shown as they
         come (:func:`app.work.in_thread`); the report and its plots replace the progress in one
-        push. The groups of plots not yet made ready for the data (a click as soon as they are
+        push. The plots not yet made ready for the data (a click as soon as they are
         shown) are made on the server while the work runs, one at a time, the work started first:
         measured with ``benchmarks/diagnose_browser.py``, making them before the work (5d78637)
         added their 0.9 s of the server's CPU to the wait. A page closed meanwhile gets nothing more."""

@@ -45,7 +45,6 @@ from ..rules import (
 
 MAX_BYTES = 20 * 1024 * 1024
 MAX_ROWS = 200_000
-MEASURED_FREQUENCY_HZ = FREQUENCY_HZ  # measured frequencies: the table's (core.parameters)
 # a loop's drive must be a steady sine: the RMS departure from the best sine, relative to its
 # amplitude, is at most this
 LOOP_SINE_DEPARTURE = 0.1
@@ -227,7 +226,7 @@ def parse_stiffness(text: str | bytes) -> MeasuredStiffness:
     v = _numbers(df, (*STIFFNESS_KEYS, *sorted(given, key=list(df.columns).index)))
     _positive(df, v, "frequency_hz")
     _positive(df, v, "amplitude")
-    lo, hi = MEASURED_FREQUENCY_HZ
+    lo, hi = FREQUENCY_HZ
     outside = np.flatnonzero((v["frequency_hz"] < lo) | (v["frequency_hz"] > hi))
     if outside.size:
         raise DataError(f"line {df.line(outside[0])}", f"frequency_hz must be within {lo:g}–{hi:g} Hz, got "
@@ -335,7 +334,7 @@ def parse_loop(text: str | bytes) -> MeasuredLoop:
 
 
 def _check_harmonic(loop: MeasuredLoop) -> None:
-    """A loop is a steady harmonic test: a frequency in :data:`MEASURED_FREQUENCY_HZ`, at least
+    """A loop is a steady harmonic test: a frequency in :data:`core.parameters.FREQUENCY_HZ`, at least
     one period recorded, a drive close to a sine."""
     t = loop.time_s
     span = t[-1] - t[0]
@@ -346,7 +345,7 @@ def _check_harmonic(loop: MeasuredLoop) -> None:
         f, amp, phase = loop.harmonic()
         x = loop.displacement / amp if amp > 0 else loop.displacement * math.inf
         departure = float(np.sqrt(np.mean((x - np.mean(x) - np.sin(phase)) ** 2)))
-    lo, hi = MEASURED_FREQUENCY_HZ
+    lo, hi = FREQUENCY_HZ
     if not (math.isfinite(f) and lo <= f <= hi):
         found = f"{format_outside(f, lo, hi, 3)} Hz" if math.isfinite(f) and f > 0 else "none found"
         raise DataError("", f"loop file: its frequency ({found}, from a time step of {dt:.3g} s) must be within "
@@ -360,9 +359,9 @@ def _check_harmonic(loop: MeasuredLoop) -> None:
 
 
 def _time_unit(frequency_hz: float) -> str:
-    """The likely cause of a loop's frequency outside :data:`MEASURED_FREQUENCY_HZ`: a time base
+    """The likely cause of a loop's frequency outside :data:`core.parameters.FREQUENCY_HZ`: a time base
     in ms or µs read as seconds, when that unit puts the frequency inside."""
-    lo, hi = MEASURED_FREQUENCY_HZ
+    lo, hi = FREQUENCY_HZ
     for unit, scale in (("milliseconds", 1e3), ("microseconds", 1e6)):
         if math.isfinite(frequency_hz) and lo <= frequency_hz * scale <= hi:
             return (f"time_s looks like {unit}: in seconds it would be a test at "
