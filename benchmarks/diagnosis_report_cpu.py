@@ -1,7 +1,7 @@
 """The server's CPU time from a diagnosis' result to its report pushed, in process (issue #27,
 item 16): prints figures, asserts nothing.
 
-    PYTHONPATH=$PWD python benchmarks/diagnosis_report_cpu.py [--runs 5] [--profile]
+    PYTHONPATH=$PWD python benchmarks/diagnosis_report_cpu.py [--runs 5] [--profile] [--walk]
 
 It runs the diagnosis of the browser benchmark's 150 points (``benchmarks/diagnose_browser.py``:
 Paper B with a hidden 0.5 kg fixture mass) once. Then ``--runs`` times, each in a new session
@@ -12,7 +12,10 @@ It prints the CPU time (``time.process_time``: this process only, other jobs on 
 not count) of the first report of a session (what every page pays) and of a second one in the
 same session, with the Bokeh models each creates and the message's size, and the CPU time of
 loading the data (what the tab makes ready for the report is made then). ``--profile`` adds
-cProfile's 25 costliest functions (cumulative) over the first reports.
+cProfile's 25 costliest functions (cumulative) over the first reports. The library hooks of
+:func:`app.patches.install` are in place, as in a served explorer; ``--walk`` leaves out the one
+that attaches the models a change added (:mod:`app.patches.model_graph`): each change that adds
+models then walks the whole document, as Bokeh does.
 """
 
 from __future__ import annotations
@@ -43,8 +46,10 @@ def session(csv: str):
     from bokeh.document import Document
     from panel.io.state import set_curdoc, state
 
+    from app import patches
     from app.main import App
 
+    patches.install()  # the process-wide hooks, as the server's first session installs them
     app = App()
     doc = Document()
     # as a server's session: a hold's end, on the session's thread, triggers the document's changes
@@ -109,7 +114,11 @@ def report(app, doc, result, prof=None) -> tuple[float, int, int]:
     return ms, len(after - before), size
 
 
-def main(runs: int, profile: bool):
+def main(runs: int, profile: bool, walk: bool = False):
+    if walk:
+        from app import patches
+
+        patches.track_reference_changes = lambda: None  # before the first session installs the hooks
     from app.main import App
 
     csv = data_csv()
@@ -140,5 +149,6 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--profile", action="store_true")
+    parser.add_argument("--walk", action="store_true", help="no attaching of added models: Bokeh's walk")
     args = parser.parse_args()
-    main(args.runs, args.profile)
+    main(args.runs, args.profile, args.walk)

@@ -8,12 +8,14 @@ Importing this module changes nothing: :func:`install` (called by :func:`app.mai
 once per session; it installs each hook once) puts the process-wide hooks in place and the
 BokehJS patches in the session's page. A notebook that imports the plotting API gets none of them.
 
-**Model recomputation.** Every HoloViews plot update freezes the Bokeh document's models, and
-Bokeh recomputes the set of models (a walk over every model) whenever the last freeze ends,
-whether or not the model graph changed: 24 ms per walk of the explorer's page, a fifth of the
-server's time per change. :func:`frozen_models` freezes the models for a whole change and
-recomputes them at its end only if Bokeh asked for it (``invalidate``: models added or removed).
-Upstream, Bokeh's ``DocumentModelManager`` could remember an ``invalidate`` while frozen.
+**Model recomputation** (:mod:`app.patches.model_graph`). Every HoloViews plot update freezes
+the Bokeh document's models, and Bokeh recomputes the set of models (a walk over every model)
+whenever the last freeze ends, whether or not the model graph changed: 24 ms per walk of the
+explorer's page, a fifth of the server's time per change. :func:`frozen_models` freezes the
+models for a whole change and recomputes them at its end only if Bokeh asked for it
+(``invalidate``: models added or removed), and a change that only added models attaches those,
+without the walk (35–50 ms per report plot made ready in the diagnosis tab). Upstream, Bokeh's
+``DocumentModelManager`` could remember an ``invalidate`` while frozen.
 
 **Sessions admitted** (:func:`route_sessions`). Bokeh's server takes its per-app routes from the
 module list ``bokeh.server.urls.per_app_patterns`` (which Panel rewrites on import); the explorer
@@ -96,7 +98,6 @@ shape written into the Bokeh models HoloViews made, through HoloViews' plot hand
 
 from __future__ import annotations
 
-import contextlib
 import inspect
 import os
 import re
@@ -114,6 +115,7 @@ from panel.reactive import Syncable
 from panel.theme import Bootstrap
 
 from .data_writes import holoviews_plots, written  # noqa: F401 - the package's names (app.live, tests)
+from .model_graph import frozen_models, track_reference_changes  # noqa: F401 - frozen_models: app.live's
 
 MATH_DELIMITERS = re.compile(r"\$\$|\\\(|\\\[")
 # the Panel internals the hooks replace or extend are there (a test fails if not)
@@ -137,6 +139,7 @@ def install(doc=None) -> None:
         hold_each_change()
         cache_immutable_defaults()
         selection_glyphs_auto()
+        track_reference_changes()
         _installed = True
     if doc is not None and doc not in _pages:
         if os.environ.get("BUSHING_BOKEHJS_PATCHES", "1") == "1":
@@ -285,31 +288,6 @@ def holds_math(roots) -> bool:
     whole = doc is not None and len(roots) == len(doc.roots) and all(r.document is doc for r in roots)
     models = doc.models if whole else (model for root in roots for model in root.references())
     return any(isinstance(model, PanelHTML) and MATH_DELIMITERS.search(model.text or "") for model in models)
-
-
-@contextlib.contextmanager
-def frozen_models(doc):
-    """``doc.models`` frozen while the block runs, recomputed at its end only if the model graph
-    changed in it (see the module). Nested inside another freeze, an ordinary freeze."""
-    models = doc.models
-    if models._freeze_count:
-        with models.freeze():
-            yield
-        return
-    changed = []
-
-    def invalidate():
-        changed.append(True)
-
-    models.invalidate = invalidate  # shadows the method for this block
-    models._push_freeze()
-    try:
-        yield
-    finally:
-        del models.invalidate
-        models._freeze_count -= 1
-        if changed and models._freeze_count == 0:
-            models.recompute()
 
 
 JS = Path(__file__).parents[1] / "js"  # the scripts the pages run, each in its own file
