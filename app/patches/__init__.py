@@ -80,6 +80,15 @@ The page sends it at FilePond's ``addfile`` (type and size checked) through the 
 ``_process_upload``; *Browse* hands the file to FilePond (``addFiles``) at once, not 250 ms later.
 A browser test checks that the bytes leave, once, while FilePond still holds the file queued.
 
+**A drop area's loop at rest while nobody uses it** (:data:`IDLE_PAINTER`). FilePond 4.32 (Panel's
+FileDropper) runs one loop for its drop areas' animations and work that asks for every frame
+from the moment its script loads (pqina/filepond#243): Chromium draws 60 frames a second on a
+page where nothing moves. While no drop area has been used for two seconds, the loop's next frame
+is asked 250 ms later; anything done at a drop area wakes it at once. Chromium's CPU per second
+at rest (``benchmarks/idle_page.py``, headless): renderer 0.067–0.070 s and other processes
+0.025–0.027 s without, 0.010 s and 0.003–0.010 s with; the rest is the server's and its worker's
+when they share the machine. A browser test counts the loop's steps at rest and after a pointer.
+
 **One set of stylesheets per component** (:class:`PageDesign`). Panel's Bootstrap template
 styles the components of the page it builds with its design's stylesheets for a part of a page
 (Panel's ``isolated=False``). A component whose model is made later (a tab opened, the report's
@@ -128,7 +137,8 @@ _pages = weakref.WeakSet()  # documents that have the BokehJS patches
 def install(doc=None) -> None:
     """Put the hooks of this module in place, each once however often it is called: the process-wide
     ones, and in the page of ``doc`` (if given) the BokehJS paint patches (unless
-    ``BUSHING_BOKEHJS_PATCHES=0``), :data:`BOKEHJS_SERVER_MODELS`, :data:`LABEL_CLICKS`, :data:`UPLOAD_AT_ONCE`."""
+    ``BUSHING_BOKEHJS_PATCHES=0``), :data:`BOKEHJS_SERVER_MODELS`, :data:`LABEL_CLICKS`, :data:`UPLOAD_AT_ONCE`,
+    :data:`IDLE_PAINTER`."""
     global _installed
     if not _installed:
         if hasattr(panel_resources, "_panel_use_mathjax"):
@@ -149,6 +159,7 @@ def install(doc=None) -> None:
         doc.js_on_event("document_ready", CustomJS(code=BOKEHJS_SERVER_MODELS))
         doc.js_on_event("document_ready", CustomJS(code=LABEL_CLICKS))
         doc.js_on_event("document_ready", CustomJS(code=UPLOAD_AT_ONCE))
+        doc.js_on_event("document_ready", CustomJS(code=IDLE_PAINTER))
         local_stylesheets(doc)
         _pages.add(doc)
 
@@ -308,6 +319,8 @@ LABEL_CLICKS = _script("label_clicks.js")
 # window.bushingUploadAtOnce: "on" once installed, "unpatched" if Panel's FileDropper view has no
 # _process_upload (then FilePond sends the file itself, after its animations)
 UPLOAD_AT_ONCE = _script("upload_at_once.js")
+# window.bushingIdlePainter: "on" once FilePond's painter is found and throttled while idle
+IDLE_PAINTER = _script("idle_painter.js")
 
 
 def install_bokehjs_patches(doc):

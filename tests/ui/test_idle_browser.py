@@ -1,0 +1,54 @@
+"""A page at rest draws nothing for its drop areas (app.patches.IDLE_PAINTER): FilePond's loop,
+which asks for every frame while the page is open, is slowed to one step per 250 ms while no drop
+area is used, and runs at every frame again once one is. The page's own frames are the clock:
+at rest, FilePond's loop does its work on at most a third of them (measured: 5 of 90; unslowed,
+on all 90); after a pointer over a drop area, on at least a quarter (measured: 40 of 40)."""
+
+import re
+from pathlib import Path
+
+from tests.ui.bokeh_page import open_explorer
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+# over `frames` of the page's frames: how many steps FilePond's loop took (its readers, called at
+# each step that does its work)
+STEPS_JS = """(frames) => new Promise((resolve) => {
+  const painter = window.__framePainter;
+  let steps = 0, seen = 0;
+  const count = () => { steps += 1; };
+  painter.readers.push(count);
+  const frame = () => {
+    seen += 1;
+    if (seen < frames) { requestAnimationFrame(frame); return; }
+    painter.readers.splice(painter.readers.indexOf(count), 1);
+    resolve(steps);
+  };
+  requestAnimationFrame(frame);
+})"""
+
+
+def test_the_drop_areas_loop_rests_while_no_drop_area_is_used(page, explorer_url):
+    open_explorer(page, explorer_url)
+    page.wait_for_function("() => window.__framePainter != null && window.bushingIdlePainter === 'on'")
+    page.get_by_text("Find the missing effect", exact=True).click()
+    area = page.locator(".filepond--root").first
+    area.wait_for()
+    area.hover()  # a pointer over the drop area: the loop runs at every frame
+    awake = page.evaluate(STEPS_JS, 40)
+    assert awake >= 10, awake
+    page.mouse.move(5, 5)  # away from it; the loop rests two seconds after the last use
+    page.wait_for_function("() => new Promise(r => setTimeout(() => r(true), 2100))")
+    resting = page.evaluate(STEPS_JS, 90)
+    assert resting <= 30, resting
+
+
+def test_a_file_dropped_at_rest_is_loaded_and_shown_complete(page, explorer_url):
+    """A file given to a drop area that rested: taken, sent and marked complete as before."""
+    open_explorer(page, explorer_url)
+    page.wait_for_function("() => true")
+    page.get_by_text("Measured data and fit", exact=True).click()
+    page.wait_for_function("() => new Promise(r => setTimeout(() => r(true), 2100))")  # the loop at rest
+    page.locator("#main input[type=file]").first.set_input_files(str(EXAMPLES / "paper_b_stiffness.csv"))
+    page.get_by_text(re.compile(r"Stiffness: 150 points")).first.wait_for()
+    page.locator(".filepond--item[data-filepond-item-state='processing-complete']").first.wait_for()
