@@ -42,19 +42,30 @@ def friction_reversal_ratio(z):
 
 def _log1p_remainder(q):
     """R(q) = ln(1 + q)/q − 1 + q/2 = q²/3 − q³/4 + …, accurate for all q ≥ 0
-    (a series below q = 0.05, where the direct form cancels)."""
+    (a series below q = 0.05, where the direct form cancels). Arrays wholly on one side of
+    0.05 (a fit's points mostly are) take their one form without the masks: the same numbers."""
     q = np.asarray(q, dtype=float)
-    out = np.empty_like(q)
     small = q < 0.05
-    qs = q[small]
+    if not small.any():
+        return _log1p_direct(q)
+    if small.all():
+        return _log1p_series(q)
+    out = np.empty_like(q)
+    out[small] = _log1p_series(q[small])
+    out[~small] = _log1p_direct(q[~small])
+    return out
+
+
+def _log1p_series(qs):
     series = np.zeros_like(qs)
     for k in range(17, 2, -1):  # Horner: Σ_{k≥3} (−1)^(k+1) q^(k−2) / k, error < 1e-18
         series *= qs
         series += (-1.0) ** (k + 1) / k
-    out[small] = series * qs * qs
-    ql = q[~small]
-    out[~small] = np.log1p(ql) / ql - 1.0 + 0.5 * ql
-    return out
+    return series * qs * qs
+
+
+def _log1p_direct(ql):
+    return np.log1p(ql) / ql - 1.0 + 0.5 * ql
 
 
 def _universal(z):
@@ -66,6 +77,8 @@ def _universal(z):
     s = np.sqrt(c * (c + 2.0 * z)) / cz
     real = c * c / (cz * cz * s * (1.0 + s))
     h = x * (x + z) - c * _log1p_remainder(2.0 * z / c)
+    if (z > 0).all():  # a fit's amplitudes: no z = 0 to guard (the same numbers, without the guard's passes)
+        return real + 1j * ((2.0 / np.pi) * h / z)
     with np.errstate(divide="ignore", invalid="ignore"):
         imag = np.where(z > 0, (2.0 / np.pi) * h / z, 0.0)
     return real + 1j * imag

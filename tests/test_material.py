@@ -88,6 +88,17 @@ def test_closed_form_equals_quadrature_of_the_loop(z):
     assert_allclose(friction_modulus_universal(z), _berg_loop_harmonic(z), rtol=1e-9)
 
 
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.one_of(st.just(0.0), st.floats(1e-7, 1e4)), min_size=1, max_size=40))
+def test_an_array_of_amplitudes_gives_each_its_own_value(z):
+    """g(z) over an array, whatever mix of small (the series' side of R(q)), large and zero
+    amplitudes it holds, is each amplitude's value alone (each alone takes one form whole):
+    the array's masks and its shortcuts when all amplitudes lie on one side change no number."""
+    alone = np.array([friction_modulus_universal(np.array([v]))[0] for v in z])
+    assert_allclose(friction_modulus_universal(np.array(z)), alone, rtol=1e-14, atol=0)
+    assert friction_modulus_universal(np.array([0.0]))[0] == 0.5  # the z → 0 limit, not 0/0
+
+
 def test_turning_point_is_the_fixed_point_of_berg_friction():
     """Simulated Berg friction driven ±ε̂ settles on the turning stress x σ_fmax."""
     for z in (0.5, 2.0, 20.0):
