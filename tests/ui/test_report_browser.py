@@ -1,12 +1,14 @@
-"""The diagnosis report in the browser (issue #27, item 16): its plots reach the page with the
-data, hidden, and the report's message brings numbers only, no new model. Each step waits for
+"""The diagnosis report in the browser (issue #27, items 8 and 16): its plots reach the page with
+the data, hidden, and the report's message brings numbers only, no new model; its maps' amplitude
+axes are labelled in every part of their range. Each step waits for
 the state it then checks, never for a time."""
 
 import pytest
 from playwright.sync_api import TimeoutError as PlaywrightTimeout
 from playwright.sync_api import expect
 
-from tests.ui.bokeh_page import FIGURE_JS, open_explorer, plots, wait_plot
+from tests.ui.bokeh_page import FIGURE_JS, open_explorer, plots, settle, wait_plot
+from tests.ui.test_data_browser import LOG_AXES_JS, assert_labelled_in_both_halves
 from tests.ui.test_waiting_browser import upload_150_points
 
 pytestmark = pytest.mark.usefixtures("console_errors", "no_server_tracebacks")
@@ -61,3 +63,18 @@ def test_after_a_diagnosis_no_component_carries_bootstraps_whole_stylesheet(page
     wait_plot(page, GAP, "p.points === 2")
     found = page.evaluate(BOOTSTRAP_ROOTS_JS)
     assert found["roots"] > 100 and found["bootstrap"] == 0, found
+
+
+def test_the_misfit_maps_amplitude_axes_are_labelled_in_every_part_of_their_range(page, explorer_url, tmp_path):
+    """The misfit maps' log amplitude axes (0.013–0.35 mm, rows at the measured amplitudes): a
+    labelled tick in each half of the axis (on 40f90b5, 0.1–0.4 mm only: the two lower rows,
+    0.013 and 0.04 mm, had none), as the measured tab's residuals have (issue #27, item 8)."""
+    open_explorer(page, explorer_url)
+    upload_150_points(page, tmp_path)
+    page.get_by_role("button", name="Diagnose").click()
+    page.get_by_text("What is left is noise", exact=True).wait_for(timeout=120_000)
+    wait_plot(page, GAP, "p.points === 2")
+    settle(page)
+    axes = [a for a in page.evaluate(LOG_AXES_JS) if "misfit" in a["title"]]
+    assert len(axes) == 4, axes
+    assert_labelled_in_both_halves(axes)
