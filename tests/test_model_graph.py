@@ -92,6 +92,19 @@ def test_a_change_of_numbers_only_walks_nothing():
     assert_settled(doc)
 
 
+def test_a_destroyed_document_is_left_alone():
+    """A page's session discarded (its document destroyed) while work still writes to it: the
+    block runs and ends without an error, and walks nothing."""
+    doc, root, _ = page()
+    child = root.children[0]
+    session = lambda _event: None  # what a server session registers, and destroy removes
+    doc.on_change(session)
+    doc.destroy(session)
+    with frozen_models(doc):
+        child.text = "late"
+        root.children = [*root.children, Div(text="late")]
+
+
 # any sequence of additions, removals, moves and replacements in one block
 OPERATIONS = st.lists(st.tuples(st.sampled_from(["add", "nest", "share", "drop", "move", "replace", "name"]),
                                 st.integers(0, 1000)), max_size=12)

@@ -94,6 +94,14 @@ def attach_added(models, changes) -> bool:
     return True
 
 
+def _roots(doc) -> list | None:
+    """The document's roots; None once it is destroyed (Bokeh's ``Document.destroy`` deletes them)."""
+    try:
+        return list(doc.roots)
+    except AttributeError:
+        return None
+
+
 @contextlib.contextmanager
 def frozen_models(doc):
     """``doc.models`` frozen while the block runs; at its end, if the model graph changed in it,
@@ -106,7 +114,7 @@ def frozen_models(doc):
             yield
         return
     log = _Log()
-    roots = list(doc.roots)
+    roots = _roots(doc)
 
     def invalidate():
         log.asked += 1
@@ -120,7 +128,9 @@ def frozen_models(doc):
         del models.invalidate
         delattr(models, _CHANGES)
         models._freeze_count -= 1
-        # a root added or removed: no reference change says so, the walk finds its models
-        roots_changed = list(doc.roots) != roots
-        if models._freeze_count == 0 and (roots_changed or (log.asked and not (tracking() and attach_added(models, log)))):
+        now = _roots(doc)
+        # a root added or removed: no reference change says so, the walk finds its models; a
+        # document destroyed (its page's session discarded) keeps nothing up to date
+        if models._freeze_count == 0 and now is not None and (
+                now != roots or (log.asked and not (tracking() and attach_added(models, log)))):
             models.recompute()
