@@ -91,7 +91,7 @@ def test_the_bokehjs_patches_go_into_a_page_once():
     patches.install(doc)
     callbacks = doc.callbacks._js_event_callbacks.get("document_ready", [])
     assert [c.code for c in callbacks] == [patches.BOKEHJS_PAINT_PATCHES, patches.BOKEHJS_SERVER_MODELS,
-                                             patches.LABEL_CLICKS, patches.UPLOAD_AT_ONCE]
+                                             patches.LABEL_CLICKS, patches.UPLOAD_AT_ONCE, patches.IDLE_PAINTER]
 
 
 def test_a_session_builds_its_stylesheets_from_this_server():
