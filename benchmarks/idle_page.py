@@ -25,32 +25,21 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+from app_latency import chromium_cpu  # CPU seconds of Chromium's processes, by type (/proc)
 from diagnose_browser import CHROMIUM, data_file  # the same data and browser
 from servers import start_explorer
 
-TICK = os.sysconf("SC_CLK_TCK")
 SETTLE_S = 3.0  # after a page is drawn or data loaded, before the rest is measured
 
 
-def chromium_cpu() -> dict[str, float]:
-    """CPU seconds so far of Chromium's renderers and of its other processes."""
-    out = {"renderer": 0.0, "other": 0.0}
-    for pid in filter(str.isdigit, os.listdir("/proc")):
-        try:
-            cmd = Path(f"/proc/{pid}/cmdline").read_bytes().decode(errors="replace")
-            fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        if "chrom" in cmd:
-            out["renderer" if "--type=renderer" in cmd else "other"] += (int(fields[11]) + int(fields[12])) / TICK
-    return out
-
-
 def at_rest(seconds: float) -> dict[str, float]:
+    """Chromium's CPU seconds per second over ``seconds``: its renderers, and its other processes."""
     start = chromium_cpu()
     time.sleep(seconds)
     end = chromium_cpu()
-    return {k: (end[k] - start[k]) / seconds for k in start}
+    used = {kind: end[kind] - start.get(kind, 0.0) for kind in end}
+    renderer = used.pop("renderer", 0.0)
+    return {"renderer": renderer / seconds, "other": sum(used.values()) / seconds}
 
 
 def measure(tree: Path, seconds: float, csv: Path) -> dict[str, dict[str, float]]:

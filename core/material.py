@@ -77,10 +77,8 @@ def _universal(z):
     s = np.sqrt(c * (c + 2.0 * z)) / cz
     real = c * c / (cz * cz * s * (1.0 + s))
     h = x * (x + z) - c * _log1p_remainder(2.0 * z / c)
-    if (z > 0).all():  # a fit's amplitudes: no z = 0 to guard (the same numbers, without the guard's passes)
-        return real + 1j * ((2.0 / np.pi) * h / z)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        imag = np.where(z > 0, (2.0 / np.pi) * h / z, 0.0)
+    positive = z > 0  # at z = 0, Im g = 0 (the limit), not 0/0
+    imag = np.where(positive, (2.0 / np.pi) * h / np.where(positive, z, 1.0), 0.0)
     return real + 1j * imag
 
 

@@ -14,6 +14,7 @@ if (window.bushingIdlePainter == null) {
   let frame = null, timer = null  // the painter's one pending request, a frame or a wait
   const isPainter = (callback) => typeof callback === "function" && callback.name === "e" &&
     Function.prototype.toString.call(callback).includes("readers.forEach")
+  const frameFor = (callback) => { frame = request((ts) => { frame = null; callback(ts) }) }
   const drop = () => {
     if (frame !== null) cancel(frame)
     if (timer !== null) clearTimeout(timer)
@@ -27,9 +28,9 @@ if (window.bushingIdlePainter == null) {
     if (callback !== painter) return request(callback)
     drop()  // FilePond asks again after a visibility change: one pending request, never two
     if (performance.now() < awakeUntil) {
-      frame = request((ts) => { frame = null; callback(ts) })
+      frameFor(callback)
     } else {
-      timer = setTimeout(() => { timer = null; frame = request((ts) => { frame = null; callback(ts) }) }, IDLE_MS)
+      timer = setTimeout(() => { timer = null; frameFor(callback) }, IDLE_MS)
     }
     return 0
   }
@@ -37,7 +38,7 @@ if (window.bushingIdlePainter == null) {
     awakeUntil = performance.now() + AWAKE_MS
     if (timer !== null && painter !== null) {
       drop()
-      frame = request((ts) => { frame = null; painter(ts) })
+      frameFor(painter)
     }
   }
   const atDropArea = (event) => event.composedPath().some((el) => el.classList?.contains("filepond--root"))
