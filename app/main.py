@@ -9,8 +9,9 @@ import signal
 import sys
 
 import panel as pn
+from tornado.ioloop import PeriodicCallback
 
-from . import admission, patches, work
+from . import admission, collector, patches, work
 from .diagnosis_state import DiagnosisState
 from .export import ExportView
 from .fit_state import FitState
@@ -213,6 +214,8 @@ def serve(port: int = 5006, address: str = "localhost", show: bool = False,
     print(f"Bushing Explorer: http://{host}:{server.port}/", flush=True)
     sys.stdout.flush()
     server.start()
+    # full garbage collections between two messages, when the server is quiet (app.collector)
+    quiet = collector.collect_when_quiet(lambda look, ms: PeriodicCallback(look, ms).start())
     # SIGTERM (a container's or a service manager's stop) ends the loop as Ctrl-C does, as `bokeh
     # serve` has it: serve returns and the worker processes stop. By default it killed the process
     # and left the workers' forkserver and worker running, orphaned (the worker holds the pipe by
@@ -221,4 +224,5 @@ def serve(port: int = 5006, address: str = "localhost", show: bool = False,
     try:
         server.io_loop.start()
     finally:
+        quiet.stop()
         work.stop_processes()

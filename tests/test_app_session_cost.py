@@ -120,7 +120,7 @@ def test_a_page_reads_few_property_defaults_through_bokeh(monkeypatch):
     assert len(doc.models) > 500 and len(asked) < 1500, (len(doc.models), len(asked))
 
 
-def test_the_server_freezes_what_it_holds_before_its_first_session(monkeypatch):
+def test_the_server_freezes_what_it_holds_before_its_first_session_and_collects_when_quiet(monkeypatch):
     """The objects a server process holds before its first session (the libraries, the app's
     caches) are moved out of the interpreter's collections (``gc.freeze``) when it starts serving:
     a collection of the oldest objects, which pages built trigger, no longer examines them."""
@@ -142,7 +142,17 @@ def test_the_server_freezes_what_it_holds_before_its_first_session(monkeypatch):
                                     "asyncio_loop": type("Asyncio", (), {"add_signal_handler": staticmethod(
                                         lambda *a: None)})()})()
 
+    class Periodic:  # the event loop's periodic call, here only recorded
+        def __init__(self, callback, ms):
+            self.callback, self.ms = callback, ms
+
+        def start(self):
+            looks.append((self.callback, self.ms, gc.get_threshold()))
+
+    looks = []
+    threshold = gc.get_threshold()
     monkeypatch.setattr(pn, "serve", lambda *a, **k: Server())
+    monkeypatch.setattr(main, "PeriodicCallback", Periodic)
     monkeypatch.setattr(main.work, "use_processes", lambda: None)
     monkeypatch.setattr(main.patches, "route_sessions", lambda *a: [])
     try:
@@ -150,6 +160,11 @@ def test_the_server_freezes_what_it_holds_before_its_first_session(monkeypatch):
     finally:
         gc.unfreeze()
     assert frozen and frozen[0] > 100_000, frozen
+    # while it serves, its full collections wait for quiet moments (app.collector), looked for
+    # once a second; CPython's own are back when it stops
+    [(look, ms, serving)] = looks
+    assert look.__self__.__class__.__name__ == "QuietCollector" and ms == 1000
+    assert serving[2] > 10 ** 6 and gc.get_threshold() == threshold
 
 
 def test_a_page_has_no_selection_glyph_models():
