@@ -3,27 +3,28 @@
 from __future__ import annotations
 
 import gc
+import sys
 import weakref
 
 import pytest
 
 from app import collector
-from app.collector import GROWTH, LATEST_S, NEVER, QUIET_SHARE, YOUNGER, QuietCollector
+from app.collector import FLOOR, GROWTH, LATEST_S, NEVER, QUIET_SHARE, YOUNGER, QuietCollector
 
 
 class Machine:
-    """A clock, the server's CPU, the oldest generation's size and the collections since the last
+    """A clock, the server's CPU, the heap's allocated blocks and the collections since the last
     full one, set by the test; the collections asked for, counted."""
 
-    def __init__(self, oldest=100_000):
-        self.now, self.used, self.size, self.younger, self.collected = 0.0, 0.0, oldest, 0, 0
+    def __init__(self, blocks=100_000):
+        self.now, self.used, self.size, self.younger, self.collected = 0.0, 0.0, blocks, 0, 0
 
     def collect(self):
         self.collected += 1
         self.size, self.younger = int(self.size * 0.9), 0  # some garbage freed
 
     def collector(self) -> QuietCollector:
-        return QuietCollector(clock=lambda: self.now, cpu=lambda: self.used, oldest=lambda: self.size,
+        return QuietCollector(clock=lambda: self.now, cpu=lambda: self.used, heap=lambda: self.size,
                               younger=lambda: self.younger, collect=self.collect)
 
     def wait(self, seconds: float, share: float):
@@ -46,8 +47,8 @@ def started(machine):
 
 
 def grow(machine):
-    """The oldest generation past CPython's rule: a quarter more, after enough younger collections."""
-    machine.size = int(machine.size * (1 + GROWTH)) + 1001
+    """The heap past the rule: a quarter more, after enough younger collections."""
+    machine.size = int(machine.size * (1 + GROWTH)) + FLOOR + 1
     machine.younger = YOUNGER
 
 
@@ -117,13 +118,15 @@ def test_start_takes_the_oldest_generation_from_cpython_and_stop_gives_it_back()
 
 def test_another_full_collection_resets_the_base():
     """Panel and Bokeh call gc.collect() after a page is discarded: the growth is counted from it."""
-    quiet = QuietCollector()
+    blocks = [500_000]
+    quiet = QuietCollector(heap=lambda: blocks[0])
     quiet.start()
     try:
-        quiet.base = 10 ** 9  # a base the oldest generation never reaches
+        assert quiet.base == 500_000
+        blocks[0] = 400_000  # a page discarded, its memory freed by someone else's collection
         gc.collect()
         quiet.look()
-        assert quiet.base == len(gc.get_objects(2))
+        assert quiet.base == 400_000
     finally:
         quiet.stop()
 
@@ -137,15 +140,18 @@ def test_a_quiet_look_frees_cyclic_garbage_of_the_oldest_generation():
     quiet = QuietCollector(cpu=lambda: 0.0)  # a server that does nothing
     quiet.start()
     try:
-        kept = [Node() for _ in range(max(20_000, int(GROWTH * len(gc.get_objects(2))) + 2000))]
+        kept = []
+        while sys.getallocatedblocks() <= quiet.base * (1 + GROWTH) + FLOOR:  # a session's worth of models
+            kept += [Node() for _ in range(10_000)]
         watched = weakref.ref(kept[0])
         for _ in range(YOUNGER + 1):
             gc.collect(1)  # the nodes survive into the oldest generation, as a session's models do
-        assert len(gc.get_objects(2)) > quiet.base * (1 + GROWTH)
+        assert quiet.due()
         del kept  # the session discarded: cyclic garbage that only a full collection frees
         assert watched() is not None
         assert quiet.look()
         assert watched() is None and quiet.collections == 1 and quiet.longest > 0
+        assert not quiet.due()
     finally:
         quiet.stop()
 
