@@ -2,16 +2,15 @@
 
 CPython collects its oldest generation by itself when it has grown by a quarter since the last
 such collection (and ten younger collections have run). That collection walks every object the
-sessions hold: measured on this server, 0.1 s with two or three pages open, 0.25-0.35 s with four,
-about 17 ms more per Explorer page (``benchmarks/gc_pauses.py``). It runs inside whatever allocates
+sessions hold: measured on this server, 0.1 s with two or three pages open, 0.25-0.35 s with four
+(with the diagnosis' plots), about 17 ms more per Explorer page held (in process). It runs inside whatever allocates
 at that moment: a page being built, a report's plots, a user's change. In a class of 30 every
 page waits for it.
 
 :class:`QuietCollector` keeps the same rule, measured on the process' heap: a quarter of growth
 of its allocated blocks since the last full collection (``sys.getallocatedblocks``, 0.1 ms with
 30 pages open; counting the oldest generation's objects took 55-60 ms then, once a second, and
-slowed every change of a class of 30 by a third), after ten younger collections. It
-runs the collection from the server's event loop, between two messages, when the server process
+slowed a class of 30's changes by a half), after ten younger collections. It runs the collection from the server's event loop, between two messages, when the server process
 has used less than :data:`QUIET_SHARE` of a core since it last looked; a collection due for
 :data:`LATEST_S` without a quiet moment runs anyway, so memory stays bounded on a server that is
 never quiet. The younger generations are collected as before (a few milliseconds each).
