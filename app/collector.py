@@ -1,19 +1,25 @@
-"""The server's full garbage collections, moved to quiet moments.
+"""The server's garbage collection: its start-up objects frozen, its full collections moved to
+quiet moments.
+
+:func:`freeze_startup_objects`: what the server holds before its first session (the libraries,
+this app's caches) lives as long as the process; frozen (the public ``gc.freeze``), a full
+collection no longer examines it.
 
 CPython collects its oldest generation by itself when it has grown by a quarter since the last
 such collection (and ten younger collections have run). That collection walks every object the
-sessions hold: measured on this server, 0.1 s with two or three pages open, 0.25-0.35 s with four
-(with the diagnosis' plots), about 17 ms more per Explorer page held (in process). It runs inside whatever allocates
-at that moment: a page being built, a report's plots, a user's change. In a class of 30 every
-page waits for it.
+sessions hold: measured on this server, 0.1 s with two or three pages open, 0.25-0.35 s with
+four (with the diagnosis' plots), about 17 ms more per Explorer page held (in process). It runs
+inside whatever allocates at that moment: a page being built, a report's plots, a user's change.
+In a class of 30 every page waits for it.
 
 :class:`QuietCollector` keeps the same rule, measured on the process' heap: a quarter of growth
 of its allocated blocks since the last full collection (``sys.getallocatedblocks``, 0.1 ms with
 30 pages open; counting the oldest generation's objects took 55-60 ms then, once a second, and
-slowed a class of 30's changes by a half), after ten younger collections. It runs the collection from the server's event loop, between two messages, when the server process
-has used less than :data:`QUIET_SHARE` of a core since it last looked; a collection due for
-:data:`LATEST_S` without a quiet moment runs anyway, so memory stays bounded on a server that is
-never quiet. The younger generations are collected as before (a few milliseconds each).
+slowed a class of 30's changes by a half), after ten younger collections. It runs the collection
+from the server's event loop, between two messages, when the server process has used less than
+:data:`QUIET_SHARE` of a core since it last looked; a collection due for :data:`LATEST_S` without
+a quiet moment runs anyway, so memory stays bounded on a server that is never quiet. The younger
+generations are collected as before (a few milliseconds each).
 
 No Panel import: the loop is tornado's (the server's), the clock and counters can be given.
 """
@@ -37,11 +43,21 @@ LATEST_S = 15.0  # a due collection waits at most this long for a quiet moment
 NEVER = 1 << 30  # the oldest generation's threshold while the collector runs: CPython never reaches it
 
 
+def freeze_startup_objects() -> int:
+    """The objects the server holds before its first session (the libraries' modules, classes,
+    option trees, this app's caches) moved out of the interpreter's cyclic collection (the public
+    ``gc.freeze``): they live as long as the process, and a collection of the oldest objects
+    no longer examines them all each time. Returns how many objects were frozen."""
+    gc.collect()
+    gc.freeze()
+    return gc.get_freeze_count()
+
+
 class QuietCollector:
     """Full collections when due (:data:`GROWTH`, :data:`YOUNGER`) and the server is quiet
     (:data:`QUIET_SHARE`), or due for :data:`LATEST_S`. :meth:`look` decides, once per
     :data:`CHECK_S`; :meth:`start` takes the oldest generation from CPython, :meth:`stop` gives it
-    back. ``collections``, ``paused`` (s, all) and ``longest`` (s) count what it did."""
+    back."""
 
     def __init__(self, *, clock: Callable[[], float] = time.monotonic, cpu: Callable[[], float] = time.process_time,
                  heap: Callable[[], int] = sys.getallocatedblocks,
@@ -50,7 +66,6 @@ class QuietCollector:
         self.clock, self.cpu, self.heap, self.younger, self.collect = clock, cpu, heap, younger, collect
         self.base = 0  # the heap's allocated blocks after the last full collection
         self.due_since: float | None = None
-        self.collections, self.paused, self.longest = 0, 0.0, 0.0
         self._threshold: tuple[int, int, int] | None = None
         self._rebase = False  # a full collection ran that this collector did not make (Panel's, Bokeh's)
         self._at, self._cpu = clock(), cpu()
@@ -76,7 +91,8 @@ class QuietCollector:
             self._rebase = True
 
     def due(self) -> bool:
-        """Whether CPython would have collected the oldest generation by now."""
+        """Whether a full collection is due: the heap grown by :data:`GROWTH` (and :data:`FLOOR`
+        blocks) since the last one, after :data:`YOUNGER` middle-generation collections."""
         return self.younger() >= YOUNGER and self.heap() > max(self.base * (1 + GROWTH), self.base + FLOOR)
 
     def look(self) -> bool:
@@ -96,7 +112,6 @@ class QuietCollector:
         start = time.perf_counter()
         self.collect()
         pause = time.perf_counter() - start
-        self.collections, self.paused, self.longest = self.collections + 1, self.paused + pause, max(self.longest, pause)
         self.base, self.due_since, self._rebase = self.heap(), None, False
         self._at, self._cpu = self.clock(), self.cpu()  # the collection's own CPU is not the pages'
         log.debug("full collection at %.0f%% of a core: %.3f s, %d blocks kept", 100 * busy, pause, self.base)

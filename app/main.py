@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import gc
 import logging
 import os
 import signal
@@ -170,17 +169,6 @@ def create_app():
     return app.template()
 
 
-def freeze_startup_objects() -> int:
-    """The objects the server holds before its first session (the libraries' modules, classes,
-    option trees, this app's caches) moved out of the interpreter's cyclic collection (the public
-    ``gc.freeze``): they live as long as the process, and a collection of the oldest objects,
-    which a session's page triggers as it is built, no longer examines them all each time.
-    Returns how many objects were frozen."""
-    gc.collect()
-    gc.freeze()
-    return gc.get_freeze_count()
-
-
 def _origins(address: str, port: int) -> list[str]:
     extra = [o for o in os.environ.get("BUSHING_ALLOWED_ORIGINS", "").split(",") if o]
     if address in ("0.0.0.0", "::", ""):
@@ -209,7 +197,7 @@ def serve(port: int = 5006, address: str = "localhost", show: bool = False,
         **SESSION_OPTIONS,
     )
     work.use_processes()  # long work (the diagnosis) in worker processes, off the pages' interpreter lock
-    freeze_startup_objects()
+    collector.freeze_startup_objects()
     host = "localhost" if address in ("0.0.0.0", "::", "") else address
     print(f"Bushing Explorer: http://{host}:{server.port}/", flush=True)
     sys.stdout.flush()

@@ -5,7 +5,7 @@ asserts nothing.
     PYTHONPATH=$PWD python benchmarks/gc_pauses.py [--pages 10] [--think 0.3]
 
 A class joins one server process: in process, as a served explorer does (the startup objects
-frozen first, :func:`app.main.freeze_startup_objects`), ``--pages`` pages are built one after the
+frozen first, :func:`app.collector.freeze_startup_objects`), ``--pages`` pages are built one after the
 other (each a session's Explorer, as ``benchmarks/mode_switch_cpu.py`` builds it), and after each
 new page every page open switches its mode to torsion and back (two changes per page, under the
 document's hold, as a click is). Between two of these ``--think`` seconds pass (the users reading);
@@ -26,15 +26,15 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
 
 
 def run(arm: str, pages: int, think: float) -> dict:
-    sys.path.insert(0, str(HERE))
-    from mode_switch_cpu import session
+    from mode_switch_cpu import session  # the app's imports: in the arm's own process only
 
-    from app import collector, main
+    from app import collector
 
-    main.freeze_startup_objects()
+    collector.freeze_startup_objects()
     quiet = collector.QuietCollector()
     if arm == "quiet":
         quiet.start()
