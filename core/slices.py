@@ -20,6 +20,7 @@ p = 1/(2π r² L), q = w / (2π r³ L) (torsion) and p = 1/(2π r L), q = w / (2
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from itertools import pairwise
 
@@ -59,12 +60,20 @@ def continuum_node_count(geometry: Geometry, mode: str) -> int:
     return int(min(64, 8 + 4 * max(1, int(np.ceil(decades)))))
 
 
+@functools.lru_cache(maxsize=64)
+def _unit_nodes(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Legendre nodes and weights of ``n`` points on (0, 1), read-only: computed once per
+    count (an eigenvalue problem, 0.3 ms: an eighth of a continuum evaluation of 150 points)."""
+    t, w = np.polynomial.legendre.leggauss(n)
+    t, w = (t + 1.0) / 2.0, w / 2.0
+    t.flags.writeable = w.flags.writeable = False
+    return t, w
+
+
 def continuum_nodes(geometry: Geometry, mode: str, n: int | None = None) -> SeriesNodes:
     """Gauss–Legendre nodes in t = ln(r/a) / ln(b/a) for the continuum limit N → ∞."""
     a, b, L = geometry.inner_radius, geometry.outer_radius, geometry.length
-    n = n or continuum_node_count(geometry, mode)
-    t, w = np.polynomial.legendre.leggauss(n)
-    t, w = (t + 1.0) / 2.0, w / 2.0
+    t, w = _unit_nodes(n or continuum_node_count(geometry, mode))
     log_ratio = np.log(b / a)
     r = a * np.exp(t * log_ratio)
     wr = w * log_ratio * r  # dr = r ln(b/a) dt
