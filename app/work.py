@@ -25,6 +25,12 @@ and the work gets its own. The workers are forked from a server process that has
 core (``forkserver``, preloaded), started when the explorer starts, so that the first task pays
 no import. A task's progress comes back through one queue, and is shown as a thread's is. An
 in-process server (the tests', a notebook's) runs tasks in a thread, as before.
+
+**Work started ahead.** Work a page will most likely ask for next (the diagnosis of data just
+loaded) can start before the click (:func:`start_ahead`), in a worker that nothing else uses; the
+click then takes it over if it is the same work (:func:`claim`), or cancels it. Work started ahead
+never delays work asked for: it starts only on an idle worker, and work asked for while every
+worker is busy cancels it (the worker stops it at its next progress report: :class:`Cancelled`).
 """
 
 from __future__ import annotations
@@ -78,6 +84,12 @@ _ids = itertools.count(1)
 relayed = 0  # progress reports received from the worker processes (tests count them)
 _queue = None  # the workers' progress queue (the parent's end)
 _worker_queue = None  # in a worker: the same queue
+_size = 0  # the pool's worker processes
+_running: set = set()  # the pool's futures not yet done (work running or waiting)
+_ahead: list = []  # the work started ahead (Started), not yet claimed nor cancelled, oldest first
+CANCEL_SLOTS = 64  # work started ahead and cancelled: its id at [id % CANCEL_SLOTS] of the shared array
+_cancelled = None  # shared with the workers: the ids of work started ahead no longer wanted
+_worker_cancelled = None  # in a worker: the same value
 
 
 def workers() -> int:
@@ -89,15 +101,15 @@ def workers() -> int:
 def use_processes(count: int | None = None) -> None:
     """Run :class:`Task` work in ``count`` worker processes (:func:`workers` if None) from now on,
     and start them (a no-op task each), so that the first page's work does not wait for them."""
-    global _pool, _queue
+    global _pool, _queue, _size, _cancelled
     with _pool_lock:
         if _pool is not None:
             return
         context = multiprocessing.get_context("forkserver")
         context.set_forkserver_preload(PRELOAD)
-        _queue = context.Queue()
-        _pool = ProcessPoolExecutor(max_workers=count or workers(), mp_context=context,
-                                    initializer=_start_worker, initargs=(_queue,))
+        _queue, _size, _cancelled = context.Queue(), count or workers(), context.RawArray("q", CANCEL_SLOTS)
+        _pool = ProcessPoolExecutor(max_workers=_size, mp_context=context,
+                                    initializer=_start_worker, initargs=(_queue, _cancelled))
         threading.Thread(target=_relay, args=(_queue,), name="work-progress", daemon=True).start()
         for _ in range(count or workers()):
             _pool.submit(int)
@@ -109,13 +121,14 @@ def stop_processes() -> None:
     global _pool
     with _pool_lock:
         pool, _pool = _pool, None
+        _ahead.clear()
     if pool is not None:
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _start_worker(queue) -> None:
-    global _worker_queue
-    _worker_queue = queue
+def _start_worker(queue, cancelled) -> None:
+    global _worker_queue, _worker_cancelled
+    _worker_queue, _worker_cancelled = queue, cancelled
 
 
 def _relay(queue) -> None:
@@ -135,22 +148,113 @@ def _relay(queue) -> None:
 def _run_task(task_id: int, task: Task) -> Any:
     """In a worker: ``task``, its progress sent to the server with ``task_id``."""
     def say(fraction: float, message: str):
+        if _worker_cancelled is not None and _worker_cancelled[task_id % CANCEL_SLOTS] == task_id:
+            raise Cancelled
         _worker_queue.put((task_id, float(fraction), str(message)))
 
     return task(say)
 
 
+class Cancelled(BaseException):
+    """In a worker: the work started ahead is no longer wanted (:func:`cancel`). Not an
+    :class:`Exception`: no ``except Exception`` of the work catches it."""
+
+
+@dataclass(eq=False)
+class Started:
+    """Work started ahead (:func:`start_ahead`): its task, the pool's future, its id and the latest
+    progress the worker reported ([fraction, message], empty before the first)."""
+
+    task: Task
+    future: Any
+    task_id: int
+    latest: list
+
+
+def _pooled(pool, task: Task, latest: list):
+    """``task`` submitted to the pool, its progress into ``latest``: the pool's future and its id."""
+    task_id = next(_ids)
+    _progress[task_id] = latest
+    try:
+        future = pool.submit(_run_task, task_id, task)
+    except BrokenProcessPool:
+        _progress.pop(task_id, None)
+        raise
+    _running.add(future)
+    future.add_done_callback(_running.discard)
+    return future, task_id
+
+
+def start_ahead(task: Task) -> Started | None:
+    """``task`` started now in a worker process, before it is asked for, if the processes are on
+    and a worker is idle (None otherwise, or if the pool is broken): :func:`claim` takes it over,
+    or :func:`cancel` stops it."""
+    pool = _pool
+    if pool is None or len(_running) >= _size:
+        return None
+    try:
+        future, task_id = _pooled(pool, task, [])
+    except BrokenProcessPool:
+        return None
+    started = Started(task, future, task_id, _progress[task_id])
+    _ahead.append(started)
+    return started
+
+
+def cancel(started: Started | None) -> None:
+    """The work ``started`` ahead no longer wanted: not started if it waits, stopped by its worker
+    at its next progress report if it runs (its progress is no longer relayed)."""
+    if started is None:
+        return
+    if started in _ahead:
+        _ahead.remove(started)
+    if not started.future.cancel() and _cancelled is not None:
+        _cancelled[started.task_id % CANCEL_SLOTS] = started.task_id
+    _progress.pop(started.task_id, None)
+
+
+def same_work(a: Task, b: Task) -> bool:
+    """Whether two tasks are the same work: the same function, each argument the same object or
+    an equal one, the same keyword arguments."""
+    def same(x, y) -> bool:
+        try:
+            return x is y or bool(x == y)
+        except (TypeError, ValueError):  # arrays and the like: only the same object is the same
+            return False
+
+    return (a.function is b.function and len(a.args) == len(b.args) and all(map(same, a.args, b.args))
+            and a.kwargs.keys() == b.kwargs.keys() and all(same(a.kwargs[k], b.kwargs[k]) for k in a.kwargs))
+
+
+def claim(started: Started | None, task: Task) -> Started | Task:
+    """What to run for ``task``: the work ``started`` ahead if it is that same task and was not
+    cancelled (it is then no longer cancelled by other work), else ``task`` (``started`` cancelled)."""
+    if (started is not None and started.task_id in _progress and not started.future.cancelled()
+            and same_work(started.task, task)):
+        if started in _ahead:
+            _ahead.remove(started)
+        return started
+    cancel(started)
+    return task
+
+
 def _submit(work, latest: list):
     """``work`` started: in a worker process if it is a :class:`Task` and the processes are on,
-    else in a thread; a future, and the id whose progress ``latest`` receives (or None)."""
+    else in a thread (a :class:`Started` goes on where it is); a future, and the id whose
+    progress ``latest`` receives (or None). Work started ahead that holds the last idle worker is
+    cancelled for it."""
+    if isinstance(work, Started):
+        latest[:] = work.latest
+        _progress[work.task_id] = latest
+        return asyncio.wrap_future(work.future), work.task_id
     pool = _pool
     if isinstance(work, Task) and pool is not None:
-        task_id = next(_ids)
-        _progress[task_id] = latest
+        if _ahead and len(_running) >= _size:
+            cancel(_ahead[0])
         try:
-            return asyncio.wrap_future(pool.submit(_run_task, task_id, work)), task_id
+            future, task_id = _pooled(pool, work, latest)
+            return asyncio.wrap_future(future), task_id
         except BrokenProcessPool:
-            _progress.pop(task_id, None)
             _reset_broken(pool)
 
     def say(fraction: float, message: str):
@@ -221,7 +325,7 @@ def page_open(doc) -> bool:
 async def in_thread(work: Callable[[Say], Any], show: Callable[[float, str], None] | None = None,
                     doc=None, meanwhile: Iterable[Callable[[], None]] = ()) -> Any:
     """``work(say)`` in a worker thread (a :class:`Task` in a worker process when they are on:
-    :func:`use_processes`); while it runs, ``show(fraction, message)`` on the event
+    :func:`use_processes`; work :class:`Started` ahead followed where it runs); while it runs, ``show(fraction, message)`` on the event
     loop with the latest ``say`` (fraction clipped to 0–1), only while the page is open and the
     work is not finishing (a fraction of 1: its result comes next, in the caller's push).
     Returns what ``work`` returns, raises what it raises; :class:`PageClosed` if the page closed

@@ -1,7 +1,9 @@
 """Long work in worker processes (app.work): a served explorer runs the diagnosis in a pool of
 worker processes, off the interpreter lock its pages' changes need. The process route gives the
 same result as the thread route, passes the work's progress on in order, raises the work's own
-errors, and falls back to a thread for work that is not a :class:`app.work.Task`."""
+errors, and falls back to a thread for work that is not a :class:`app.work.Task`. Work started
+ahead (the diagnosis of data just loaded) is taken over by the click that asks for that same
+work, and gives way to any other."""
 
 import asyncio
 import os
@@ -31,6 +33,18 @@ def pid_of(progress=None):
     if progress is not None:
         progress(0.5, "half way")
     return os.getpid()
+
+
+def token(progress=None):
+    """Eight random bytes: each run of it gives others."""
+    return os.urandom(8)
+
+
+def count_to(n, progress=None):
+    """Says its progress ``n`` times; how many it said."""
+    for i in range(n):
+        progress(i / n, f"step {i}")
+    return n
 
 
 def refuse(progress=None):
@@ -88,3 +102,46 @@ def test_a_write_to_a_closed_page_that_nobody_awaited_is_not_logged(caplog):
         assert [r.levelname for r in logged] == ["ERROR", "ERROR"]
     finally:
         loop.close()
+
+
+def test_work_started_ahead_is_taken_over_by_the_same_work(processes):
+    async def click():
+        started = work.start_ahead(work.Task(token))
+        assert started is not None
+        assert work.claim(started, work.Task(token)) is started
+        return started, await work.in_thread(work.claim(started, work.Task(token)))
+
+    started, got = asyncio.run(click())
+    assert got == started.future.result()  # one run, not a second
+
+
+def test_work_started_ahead_gives_way_to_other_work(processes):
+    """It stops at its next progress report: its million reports are not made."""
+    async def others():
+        ahead = work.start_ahead(work.Task(count_to, (10**6,)))
+        assert ahead is not None and work.start_ahead(work.Task(token)) is None  # the one worker is busy
+        pid = await work.in_thread(work.Task(pid_of))  # asked for while it runs: it is cancelled
+        other = work.start_ahead(work.Task(count_to, (10**6,)))
+        assert work.claim(other, work.Task(count_to, (10**6 + 1,))) == work.Task(count_to, (10**6 + 1,))
+        return ahead, other, pid
+
+    ahead, other, pid = asyncio.run(others())
+    assert pid != os.getpid()
+    for started in (ahead, other):
+        assert started.future.cancelled() or isinstance(started.future.exception(timeout=120), work.Cancelled)
+
+
+def test_a_diagnosis_click_takes_over_the_diagnosis_started_with_the_data_if_nothing_changed(processes):
+    from app.main import App
+
+    view = App().diagnosis
+    assert view.state.load_csv(data().to_csv(), "inertia.csv")
+    started = view._ahead
+    assert started is not None
+    asyncio.run(view._run())
+    assert view.state.result is started.future.result() and view.state.result.added == ["inertia"]
+    # the baseline changed after the data came: the click diagnoses with the new one
+    assert view.state.load_csv(data().to_csv(), "inertia.csv")
+    view.state.baseline = ["elastic", "friction"]
+    asyncio.run(view._run())
+    assert view.state.result.baseline.model.branches == ("elastic", "friction")

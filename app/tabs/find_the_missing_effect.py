@@ -24,7 +24,7 @@ from ..plotting.style import SWEEP_PALETTES, sweep_label
 from ..shapes import shape_pane
 from ..units import amplitude_unit
 from ..uploads import csv_dropper, on_upload, verdict_html
-from ..work import PageClosed, in_thread, page_open
+from ..work import PageClosed, cancel, claim, in_thread, page_open, start_ahead
 
 log = logging.getLogger("bushing.app")
 
@@ -111,6 +111,7 @@ class DiagnosisView(pn.viewable.Viewer):
         self._ready: set[tuple[str, int]] = set()  # the plots made ready for the loaded data (PREPARE_STEPS)
         self._overlays: dict | None = None  # what they were made with (_pending)
         self._shown: dict[str, dict] = {}  # the overlays each group's LivePlot was last given
+        self._ahead = None  # the diagnosis of the loaded data started ahead of the click (_on_data)
         # a place in the page for each plot, filled when the plot is first made (the grid never changes)
         self._slots = {name: [pn.Column(sizing_mode="stretch_width") for _ in range(PLOT_COUNTS[name])]
                        for name in PLOT_GROUPS}
@@ -165,10 +166,11 @@ class DiagnosisView(pn.viewable.Viewer):
         shown) are made on the server while the work runs, one at a time, the work started first:
         measured with ``benchmarks/diagnose_browser.py``, making them before the work (5d78637)
         added their 0.9 s of the server's CPU to the wait. A page closed meanwhile gets nothing more."""
-        state = self.state
+        state, ahead, self._ahead = self.state, self._ahead, None
         unready = [partial(self._prepare, *step) for step in PREPARE_STEPS if step not in self._ready]
         try:  # in a worker process when the server has them (app.work.use_processes)
-            result = await in_thread(state.task(), self._show_progress, pn.state.curdoc, meanwhile=unready)
+            work = claim(ahead, state.task())  # the diagnosis started with the data, if it is this one
+            result = await in_thread(work, self._show_progress, pn.state.curdoc, meanwhile=unready)
         except PageClosed:
             return  # nothing is written to a closed page's document, not even "running" ended
         except (ValueError, ConvergenceError) as exc:
@@ -196,7 +198,18 @@ class DiagnosisView(pn.viewable.Viewer):
         """New data: the report's plots are made ready for them once the data are on the page
         (:meth:`_prepare`; on a served page the data's message goes first, then one plot every
         :data:`PREPARE_GAP_MS`, so that a click on *Diagnose* waits for one plot at most; the
-        plots left are made while the diagnosis runs: :meth:`_diagnose`)."""
+        plots left are made while the diagnosis runs: :meth:`_diagnose`).
+
+        The diagnosis of the new data starts at once in an idle worker process, if the server has
+        one (:func:`app.work.start_ahead`): the click takes it over if nothing it depends on
+        changed meanwhile (the design, the baseline), else starts its own."""
+        cancel(self._ahead)
+        self._ahead = None
+        if self.state.data is not None and not self.state.running:
+            try:
+                self._ahead = start_ahead(self.state.task())
+            except ValueError:
+                pass  # the data cannot be diagnosed as they are: the click says why
         self._prepared += 1
         self._ready, self._overlays = set(), None
         generation, doc = self._prepared, pn.state.curdoc
