@@ -86,7 +86,7 @@ _queue = None  # the workers' progress queue (the parent's end)
 _worker_queue = None  # in a worker: the same queue
 _size = 0  # the pool's worker processes
 _running: set = set()  # the pool's futures not yet done (work running or waiting)
-_ahead: list = []  # the work started ahead (Started), not yet claimed nor cancelled, oldest first
+_ahead: list = []  # the work started ahead (Started) and running, not yet claimed nor cancelled, oldest first
 CANCEL_SLOTS = 64  # work started ahead and cancelled: its id at [id % CANCEL_SLOTS] of the shared array
 _cancelled = None  # shared with the workers: the ids of work started ahead no longer wanted
 _worker_cancelled = None  # in a worker: the same value
@@ -162,13 +162,31 @@ class Cancelled(BaseException):
 
 @dataclass(eq=False)
 class Started:
-    """Work started ahead (:func:`start_ahead`): its task, the pool's future, its id and the latest
-    progress the worker reported ([fraction, message], empty before the first)."""
+    """Work started ahead (:func:`start_ahead`): its task, the pool's future, its id, the latest
+    progress the worker reported ([fraction, message], empty before the first) and whether it
+    was cancelled. Its result is held by whoever holds it (the page that loaded the data), not
+    here: work that ended unclaimed is forgotten with its page."""
 
     task: Task
     future: Any
     task_id: int
     latest: list
+    cancelled: bool = False
+
+
+def _ended(started: Started) -> None:
+    """``started`` has ended: nothing left to cancel, no progress to relay (a click that takes it
+    over later reads its last progress from it)."""
+    _forget(started)
+    _progress.pop(started.task_id, None)
+
+
+def _forget(started: Started) -> None:
+    """``started`` no longer among the work that other work may cancel."""
+    try:
+        _ahead.remove(started)
+    except ValueError:
+        pass  # claimed, cancelled or ended already
 
 
 def _pooled(pool, task: Task, latest: list):
@@ -198,6 +216,7 @@ def start_ahead(task: Task) -> Started | None:
         return None
     started = Started(task, future, task_id, _progress[task_id])
     _ahead.append(started)
+    future.add_done_callback(lambda _future: _ended(started))
     return started
 
 
@@ -206,8 +225,8 @@ def cancel(started: Started | None) -> None:
     at its next progress report if it runs (its progress is no longer relayed)."""
     if started is None:
         return
-    if started in _ahead:
-        _ahead.remove(started)
+    started.cancelled = True
+    _forget(started)
     if not started.future.cancel() and _cancelled is not None:
         _cancelled[started.task_id % CANCEL_SLOTS] = started.task_id
     _progress.pop(started.task_id, None)
@@ -229,10 +248,9 @@ def same_work(a: Task, b: Task) -> bool:
 def claim(started: Started | None, task: Task) -> Started | Task:
     """What to run for ``task``: the work ``started`` ahead if it is that same task and was not
     cancelled (it is then no longer cancelled by other work), else ``task`` (``started`` cancelled)."""
-    if (started is not None and started.task_id in _progress and not started.future.cancelled()
+    if (started is not None and not started.cancelled and not started.future.cancelled()
             and same_work(started.task, task)):
-        if started in _ahead:
-            _ahead.remove(started)
+        _forget(started)
         return started
     cancel(started)
     return task

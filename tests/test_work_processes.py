@@ -145,3 +145,19 @@ def test_a_diagnosis_click_takes_over_the_diagnosis_started_with_the_data_if_not
     view.state.baseline = ["elastic", "friction"]
     asyncio.run(view._run())
     assert view.state.result.baseline.model.branches == ("elastic", "friction")
+
+
+def test_work_started_ahead_that_ended_unclaimed_is_held_only_by_whoever_started_it(processes):
+    """A page that loaded data and closed without a click leaves nothing behind in the server."""
+    import gc
+    import weakref
+
+    async def unclaimed():
+        started = work.start_ahead(work.Task(token))
+        await asyncio.wrap_future(started.future)
+        await work.in_thread(work.Task(pid_of))  # and other work after it
+        return weakref.ref(started), started.future.result()
+
+    ref, got = asyncio.run(unclaimed())
+    gc.collect()
+    assert ref() is None and len(got) == 8
