@@ -317,7 +317,8 @@ BOKEHJS_SERVER_MODELS = _script("server_models.js")
 # open shadow roots) holds such a label and not the box itself clicks the box of the same root.
 LABEL_CLICKS = _script("label_clicks.js")
 # window.bushingUploadAtOnce: "on" once installed, "unpatched" if Panel's FileDropper view has no
-# _process_upload (then FilePond sends the file itself, after its animations)
+# _process_upload (then FilePond sends the file itself, after its animations); it also turns off
+# FilePond's minimum upload duration, so that a file sent is shown complete
 UPLOAD_AT_ONCE = _script("upload_at_once.js")
 # window.bushingIdlePainter: "on" once FilePond's painter is found and throttled while idle
 IDLE_PAINTER = _script("idle_painter.js")

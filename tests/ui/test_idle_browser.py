@@ -78,3 +78,19 @@ def test_a_file_sent_turns_no_ring_while_the_page_waits(page, explorer_url):
     page.locator("#main input[type=file]").last.set_input_files(str(EXAMPLES / "paper_b_stiffness.csv"))
     seen = page.wait_for_function(BUSY_SPINS_JS, polling="raf").json_value()
     assert seen == {"spinning": 0}
+
+
+def test_a_file_sent_is_complete_without_a_played_progress(page, explorer_url):
+    """FilePond plays a file's progress over 0.75-1.5 s however fast it went ("minimum upload
+    duration"), and kept the area saying "Uploading" while the file's data were on the page
+    (app/js/upload_at_once.js turns it off): every progress it reports, if any, is the whole file
+    (on 2e70b6c: 0.10, 0.21, 0.29, … played for a file sent at once)."""
+    open_explorer(page, explorer_url)
+    page.get_by_text("Find the missing effect", exact=True).click()
+    page.get_by_role("button", name="Diagnose").wait_for()
+    page.evaluate("""() => { window.bushingProgress = [];
+      document.addEventListener('FilePond:processfileprogress', (e) => window.bushingProgress.push(e.detail.progress), true); }""")
+    page.locator("#main input[type=file]").last.set_input_files(str(EXAMPLES / "paper_b_stiffness.csv"))
+    page.locator(".filepond--item[data-filepond-item-state='processing-complete']").last.wait_for()
+    reported = page.evaluate("() => window.bushingProgress")
+    assert all(p == 1 for p in reported), reported
