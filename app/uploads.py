@@ -31,21 +31,12 @@ SENT_CSS = """
 """
 
 
-# FilePond turns a file's progress ring for as long as the file is "busy": 2.3-3.1 s after the
-# file is handed over, while the data's line is on the page after 0.1-0.2 s. That endless CSS
-# animation is drawn by the browser's CPU where it has no GPU (headless Chromium: 1.67 s of its
-# CPU from the hand-over to the file no longer busy, against 1.46 s stopped; medians of 8
-# uploads in Find the missing effect), when a diagnosis clicked then needs the cores. The ring
-# still fills with the bytes sent; it no longer turns
-STILL_CSS = ".filepond--progress-indicator svg { animation: none !important; }"
-
-
 def csv_dropper(multiple: bool = False) -> pn.widgets.FileDropper:
     """A drop area for one CSV file (or up to :data:`MAX_FILES`) of at most :data:`MAX_BYTES` each."""
     return pn.widgets.FileDropper(
         accepted_filetypes=[".csv", "text/csv", "text/plain"], max_file_size=LIMIT, chunk_size=CHUNK_BYTES,
         multiple=multiple, max_files=MAX_FILES if multiple else None, previews=[], layout="compact",
-        sizing_mode="stretch_width", stylesheets=[SENT_CSS, STILL_CSS], **({"min_height": 90} if multiple else {"height": 90}),  # a list grows
+        sizing_mode="stretch_width", stylesheets=[SENT_CSS], **({"min_height": 90} if multiple else {"height": 90}),  # a list grows
     )
 
 
@@ -55,7 +46,7 @@ def design_dropper() -> pn.widgets.FileDropper:
     return pn.widgets.FileDropper(
         accepted_filetypes=[".json", "application/json"], max_file_size=f"{MAX_DESIGN_BYTES // 1000}KB",
         chunk_size=CHUNK_BYTES, multiple=False, previews=[], layout="compact", sizing_mode="stretch_width",
-        height=70, stylesheets=[STILL_CSS],
+        height=70,
     )
 
 

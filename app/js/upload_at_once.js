@@ -47,8 +47,11 @@ if (window.bushingUploadAtOnce == null) {
       if (input == null || view == null || input.bushingAtOnce) return
       input.bushingAtOnce = true
       // and a file is complete when its last byte has gone: FilePond's "minimum upload duration"
-      // (a progress it plays over 0.75-1.5 s whatever the transfer) kept the area saying
-      // "Uploading" for 2.3-3.1 s while the file's data were on the page
+      // (a progress it plays over 0.75-1.5 s whatever the transfer) kept the area "busy", saying
+      // "Uploading" and turning its ring (drawn by the CPU of a browser without GPU), while the
+      // file's data were on the page: busy until 3.05 s after the hand-over, Chromium's CPU
+      // meanwhile 1.77 s; now 1.49 s and 1.00 s (benchmarks/drop_area_busy.py, medians of 6,
+      // 2026-12-06; with the ring held still as well, 0.98 s: no more worth a stylesheet)
       view._file_pond.setOptions({allowMinimumUploadDuration: false})
       input.addEventListener("change", (event) => {
         if (!input.files || input.files.length == 0) return

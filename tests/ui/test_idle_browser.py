@@ -54,31 +54,6 @@ def test_a_file_dropped_at_rest_is_loaded_and_shown_complete(page, explorer_url)
     page.locator(".filepond--item[data-filepond-item-state='processing-complete']").first.wait_for()
 
 
-# once a drop area holds a file FilePond calls busy (it does for about 2.5 s after the file is
-# handed over, the data shown after 0.1-0.2 s): how many of the page's animations turn a ring
-BUSY_SPINS_JS = """() => {
-  let busy = 0, spinning = 0;
-  const walk = (root) => {
-    busy += root.querySelectorAll("[data-filepond-item-state*='busy']").length;
-    spinning += root.getAnimations().filter(a => a.animationName === 'spin' && a.playState === 'running').length;
-    for (const el of root.querySelectorAll('*')) if (el.shadowRoot) walk(el.shadowRoot);
-  };
-  walk(document);
-  return busy ? {spinning} : null;
-}"""
-
-
-def test_a_file_sent_turns_no_ring_while_the_page_waits(page, explorer_url):
-    """FilePond's busy file turns its progress ring in an endless CSS animation, drawn by the CPU
-    where the browser has no GPU, while a diagnosis clicked then needs it (app.uploads.STILL_CSS:
-    two rings turned on 63e5360)."""
-    open_explorer(page, explorer_url)
-    page.get_by_text("Find the missing effect", exact=True).click()
-    page.get_by_role("button", name="Diagnose").wait_for()
-    page.locator("#main input[type=file]").last.set_input_files(str(EXAMPLES / "paper_b_stiffness.csv"))
-    seen = page.wait_for_function(BUSY_SPINS_JS, polling="raf").json_value()
-    assert seen == {"spinning": 0}
-
 
 def test_a_file_sent_is_complete_without_a_played_progress(page, explorer_url):
     """FilePond plays a file's progress over 0.75-1.5 s however fast it went ("minimum upload
