@@ -13,6 +13,10 @@ const patch = (flag, done, module, cls, method, wrap) => {
 }
 patch("bushingStyleWrites", "skip-unchanged", "core/dom", "InlineStyleSheet", "_update", (update) =>
   function (css) { if (this.el.textContent !== css) update.call(this, css) })
+// A line's, a fill's or a text's CSS variables read once per task and visual. Read once for the
+// visual's life instead (no theming after its first paint), the diagnosis clicked at once measured
+// the same (median 2.6 s, 8 runs each, 2026-12-06): the renderer's 0.2 s of getPropertyValue per
+// diagnosis moved to its other style recalculations, so the per-task cache stays
 patch("bushingCssReads", "cached-per-task", "core/visuals/visual", "VisualProperties", "_get_css_value", (read) =>
   function (name) {
     if (this._bushing_css == null) {
