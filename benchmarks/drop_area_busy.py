@@ -1,7 +1,7 @@
 """How long a drop area calls a sent file "busy", and what Chromium spends meanwhile (issue #27,
 items 12 and 16): prints figures, asserts nothing.
 
-    PYTHONPATH=$PWD python benchmarks/drop_area_busy.py [--uploads 4] [--turning] [--tree PATH]
+    PYTHONPATH=$PWD python benchmarks/drop_area_busy.py [--uploads 4] [--still] [--tree PATH]
 
 It serves the explorer of ``--tree`` (the working tree by default; ``git worktree add`` another
 commit to measure it), opens it in the system Chromium (headless, no GPU) and ``--uploads`` times:
@@ -9,9 +9,8 @@ a new page, *Find the missing effect*, 1 s at rest, then the 150 points of diagn
 handed to its drop area. Per upload: the data's line on the page and the drop area's file no
 longer busy (FilePond's ``data-filepond-item-state`` "processing-complete"), in s from the
 hand-over (Playwright's clock, a poll every 50 ms), and the CPU of every Chromium process over that
-time (utime + stime, /proc). ``--turning`` puts FilePond's turning ring back (a stylesheet in each
-drop area), to measure what a still ring would save (the
-drop areas no longer hold it still: with the minimum upload duration off, it saved nothing measurable). The diagnosis started with the data runs
+time (utime + stime, /proc). ``--still`` holds FilePond's progress ring still (a stylesheet in
+each drop area): what a still ring would save. The diagnosis started with the data runs
 meanwhile on the server's worker process (docs/serving.md), as it does for a user.
 """
 
@@ -37,10 +36,10 @@ STATES_JS = """() => { const out = []; const walk = (root) => {
   for (const el of root.querySelectorAll('[data-filepond-item-state]')) out.push(el.getAttribute('data-filepond-item-state'));
   for (const el of root.querySelectorAll('*')) if (el.shadowRoot) walk(el.shadowRoot); };
   walk(document); return out.join(','); }"""
-# FilePond's own rule, put back in every drop area's shadow root
-TURNING_JS = """() => { const walk = (root) => { for (const el of root.querySelectorAll('*')) if (el.shadowRoot) {
+# the ring held still, a rule in every drop area's shadow root
+STILL_JS = """() => { const walk = (root) => { for (const el of root.querySelectorAll('*')) if (el.shadowRoot) {
   if (el.shadowRoot.querySelector('.filepond--root')) { const s = new CSSStyleSheet();
-    s.replaceSync("[data-filepond-item-state*='busy'] .filepond--progress-indicator svg { animation: spin 1s linear infinite !important; }");
+    s.replaceSync(".filepond--progress-indicator svg { animation: none !important; }");
     el.shadowRoot.adoptedStyleSheets = [...el.shadowRoot.adoptedStyleSheets, s]; }
   walk(el.shadowRoot); } }; walk(document); }"""
 
@@ -57,14 +56,14 @@ def chromium_cpu() -> float:
     return total / 100
 
 
-def upload(page, url: str, csv: Path, turning: bool) -> dict:
+def upload(page, url: str, csv: Path, still: bool) -> dict:
     page.goto(url)
     page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0 && Bokeh.documents[0].is_idle",
                            timeout=120_000)
     page.get_by_text("Find the missing effect", exact=True).click()
     page.get_by_role("button", name="Diagnose").wait_for(timeout=60_000)
-    if turning:
-        page.evaluate(TURNING_JS)
+    if still:
+        page.evaluate(STILL_JS)
     page.wait_for_timeout(1000)
     cpu, start = chromium_cpu(), time.perf_counter()
     page.locator("#main input[type=file]").last.set_input_files(str(csv))
@@ -77,7 +76,7 @@ def upload(page, url: str, csv: Path, turning: bool) -> dict:
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--uploads", type=int, default=4)
-    parser.add_argument("--turning", action="store_true", help="FilePond's turning ring put back")
+    parser.add_argument("--still", action="store_true", help="FilePond's ring held still")
     parser.add_argument("--tree", type=Path, default=HERE.parent)
     args = parser.parse_args()
     from playwright.sync_api import sync_playwright
@@ -90,14 +89,14 @@ def main():
             with sync_playwright() as p:
                 browser = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--disable-gpu"])
                 page = browser.new_page(viewport={"width": 1500, "height": 1300})
-                out = [upload(page, url, csv, args.turning) for _ in range(args.uploads)]
+                out = [upload(page, url, csv, args.still) for _ in range(args.uploads)]
                 browser.close()
         finally:
             proc.send_signal(signal.SIGINT)
             proc.wait(timeout=30)
     for r in out:
         print(f"data's line {r['shown']:.2f} s, busy until {r['busy']:.2f} s, Chromium's CPU meanwhile {r['cpu']:.2f} s")
-    print(f"medians of {len(out)}{' (ring turning)' if args.turning else ''}: data's line "
+    print(f"medians of {len(out)}{' (ring held still)' if args.still else ''}: data's line "
           f"{statistics.median(r['shown'] for r in out):.2f} s, busy until {statistics.median(r['busy'] for r in out):.2f} s, "
           f"Chromium's CPU {statistics.median(r['cpu'] for r in out):.2f} s")
 
