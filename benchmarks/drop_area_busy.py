@@ -1,7 +1,7 @@
 """How long a drop area calls a sent file "busy", and what Chromium spends meanwhile (issue #27,
 items 12 and 16): prints figures, asserts nothing.
 
-    PYTHONPATH=$PWD python benchmarks/drop_area_busy.py [--uploads 4] [--still] [--tree PATH]
+    PYTHONPATH=$PWD python benchmarks/drop_area_busy.py [--uploads 8] [--still] [--tree PATH]
 
 It serves the explorer of ``--tree`` (the working tree by default; ``git worktree add`` another
 commit to measure it), opens it in the system Chromium (headless, no GPU) and ``--uploads`` times:
@@ -9,8 +9,9 @@ a new page, *Find the missing effect*, 1 s at rest, then the 150 points of diagn
 handed to its drop area. Per upload: the data's line on the page and the drop area's file no
 longer busy (FilePond's ``data-filepond-item-state`` "processing-complete"), in s from the
 hand-over (Playwright's clock, a poll every 50 ms), and the CPU of every Chromium process over that
-time (utime + stime, /proc). ``--still`` holds FilePond's progress ring still (a stylesheet in
-each drop area): what a still ring would save. The diagnosis started with the data runs
+time (utime + stime, /proc), and how many progress rings turn when the data's line is shown.
+``--still`` holds FilePond's progress ring still (a rule in each drop area): what a still ring
+would save. The diagnosis started with the data runs
 meanwhile on the server's worker process (docs/serving.md), as it does for a user.
 """
 
@@ -43,6 +44,12 @@ STILL_JS = """() => { const walk = (root) => { for (const el of root.querySelect
     el.shadowRoot.adoptedStyleSheets = [...el.shadowRoot.adoptedStyleSheets, s]; }
   walk(el.shadowRoot); } }; walk(document); }"""
 
+# how many of the page's animations turn a ring now
+SPINS_JS = """() => { let n = 0; const walk = (root) => {
+  n += root.getAnimations().filter(a => a.animationName === 'spin' && a.playState === 'running').length;
+  for (const el of root.querySelectorAll('*')) if (el.shadowRoot) walk(el.shadowRoot); };
+  walk(document); return n; }"""
+
 
 def chromium_cpu() -> float:
     """CPU seconds of every Chromium process so far."""
@@ -69,13 +76,14 @@ def upload(page, url: str, csv: Path, still: bool) -> dict:
     page.locator("#main input[type=file]").last.set_input_files(str(csv))
     page.get_by_text("150 points").first.wait_for(timeout=60_000)
     shown = time.perf_counter() - start
+    spins = page.evaluate(SPINS_JS)
     page.wait_for_function(f"() => ({STATES_JS})().includes('processing-complete')", polling=50, timeout=60_000)
-    return {"shown": shown, "busy": time.perf_counter() - start, "cpu": chromium_cpu() - cpu}
+    return {"spins": spins, "shown": shown, "busy": time.perf_counter() - start, "cpu": chromium_cpu() - cpu}
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--uploads", type=int, default=4)
+    parser.add_argument("--uploads", type=int, default=8)
     parser.add_argument("--still", action="store_true", help="FilePond's ring held still")
     parser.add_argument("--tree", type=Path, default=HERE.parent)
     args = parser.parse_args()
@@ -95,7 +103,7 @@ def main():
             proc.send_signal(signal.SIGINT)
             proc.wait(timeout=30)
     for r in out:
-        print(f"data's line {r['shown']:.2f} s, busy until {r['busy']:.2f} s, Chromium's CPU meanwhile {r['cpu']:.2f} s")
+        print(f"data's line {r['shown']:.2f} s ({r['spins']} ring(s) turning then), busy until {r['busy']:.2f} s, Chromium's CPU meanwhile {r['cpu']:.2f} s")
     print(f"medians of {len(out)}{' (ring held still)' if args.still else ''}: data's line "
           f"{statistics.median(r['shown'] for r in out):.2f} s, busy until {statistics.median(r['busy'] for r in out):.2f} s, "
           f"Chromium's CPU {statistics.median(r['cpu'] for r in out):.2f} s")

@@ -51,8 +51,9 @@ if (window.bushingUploadAtOnce == null) {
       // "Uploading" and turning its ring (drawn by the CPU of a browser without GPU), while the
       // file's data were on the page: busy until 3.05 s after the hand-over, Chromium's CPU
       // meanwhile 1.77 s; now 1.49 s and 1.00 s (benchmarks/drop_area_busy.py, medians of 6,
-      // 2026-12-06; the ring held still as well, drop_area_busy.py --still: 0.93 s against 1.08 s,
-      // medians of 4: a still ring is worth restoring)
+      // 2026-12-06). Holding the ring still as well saves nothing measurable: Chromium's CPU
+      // 1.11 s and 1.11 s with it still, 1.04 s and 1.10 s with it turning (drop_area_busy.py
+      // [--still], two batches of 8 uploads each; 0.93 s against 1.08 s in one batch of 4 was noise)
       view._file_pond.setOptions({allowMinimumUploadDuration: false})
       input.addEventListener("change", (event) => {
         if (!input.files || input.files.length == 0) return
