@@ -1,11 +1,12 @@
 """The diagnosis as a user waits for it in Chromium (issue #27, items 12 and 16): prints figures,
 asserts nothing.
 
-    PYTHONPATH=$PWD python benchmarks/diagnose_browser.py [--runs 5] [--before REV] [--pause S]
+    PYTHONPATH=$PWD python benchmarks/diagnose_browser.py [--runs 5] [--before REV] [--pause S] [--choose S]
 
 It serves the explorer of the working tree (``bushing serve --port 0``, reading the URL it
 prints), opens it in the system Chromium (headless), and ``--runs`` times: loads the page, opens
-*Find the missing effect*, uploads 150 measured points (Paper B with a hidden 0.5 kg fixture
+*Find the missing effect*, waits ``--choose`` seconds (1 by default: a user choosing the file; the
+page at rest after it), uploads 150 measured points (Paper B with a hidden 0.5 kg fixture
 mass, 30 frequencies × 5 amplitudes, 0.5 % noise: :func:`core.synthetic.synthetic_stiffness`),
 clicks *Diagnose* and measures, in the page (``performance.now()``, a MutationObserver), the
 time from the click to the report shown with its plots drawn (the text "What is left is noise"
@@ -83,7 +84,7 @@ _WATCH_JS = """() => {
 }"""
 
 # the gap chart holds the report's bars: the baseline's and the found effect's (the chart is made,
-# hidden, with the baseline's bar alone when the data are loaded)
+# hidden, with the baseline's bar alone when the tab opens)
 DRAWN_JS = """(title) => [...Bokeh.documents[0].all_models].some(m => m.type === 'Figure' && m.title &&
   m.title.text === title && m.renderers.some(r => r.data_source && r.data_source.data &&
   Object.values(r.data_source.data).some(c => c && c.length > 1)))"""
@@ -117,13 +118,15 @@ def data_file(path: Path):
                         noise=0.005, seed=3).to_csv(path)
 
 
-def measure(page, url: str, csv: Path, pause: float = 0.0) -> dict:
+def measure(page, url: str, csv: Path, pause: float = 0.0, choose: float = 1.0) -> dict:
     """One diagnosis on a fresh page: seconds to the report drawn, to the first progress shown."""
     page.goto(url)
     page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0 && Bokeh.documents[0].is_idle",
                            timeout=120_000)
     page.get_by_text("Find the missing effect", exact=True).click()
     page.get_by_role("button", name="Diagnose").wait_for(timeout=60_000)
+    page.wait_for_timeout(1000 * choose)  # a user choosing the file (benchmark only)
+    page.wait_for_function("() => Bokeh.documents[0].is_idle", timeout=60_000)
     page.evaluate(UPLOAD_JS)
     page.locator("#main input[type=file]").last.set_input_files(str(csv))
     page.get_by_text("150 points").first.wait_for(timeout=60_000)
@@ -158,7 +161,7 @@ def metrics(cdp) -> dict:
     return {m["name"]: m["value"] for m in cdp.send("Performance.getMetrics")["metrics"]}
 
 
-def run_tree(tree: Path, runs: int, csv: Path, pause: float = 0.0) -> list[dict]:
+def run_tree(tree: Path, runs: int, csv: Path, pause: float = 0.0, choose: float = 1.0) -> list[dict]:
     from playwright.sync_api import sync_playwright
 
     proc, url = start_explorer(tree)
@@ -167,7 +170,7 @@ def run_tree(tree: Path, runs: int, csv: Path, pause: float = 0.0) -> list[dict]
             browser = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--disable-gpu"])
             page = browser.new_page(viewport={"width": 1500, "height": 1300})
             measure(page, url, csv)  # warm: the server's first imports and caches
-            out = [measure(page, url, csv, pause) for _ in range(runs)]
+            out = [measure(page, url, csv, pause, choose) for _ in range(runs)]
             browser.close()
     finally:  # as Ctrl-C: the server stops its worker processes (a kill leaves them running)
         proc.send_signal(signal.SIGINT)
@@ -204,6 +207,8 @@ def main():
                         help="with --before: two batches of --runs for each tree, in the order now, before, before, now")
     parser.add_argument("--pause", type=float, default=0.0,
                         help="seconds between the data shown and the click (a user reading them); default 0")
+    parser.add_argument("--choose", type=float, default=1.0,
+                        help="seconds between the tab shown and the file handed over (a user choosing it); default 1")
     args = parser.parse_args()
     runs = 2 * args.runs if args.abba and args.before else args.runs
     print(f"diagnosis of 150 points in Chromium, median of {runs} runs (target ≤ {TARGET_S:.0f} s); "
@@ -212,7 +217,7 @@ def main():
         csv = Path(tmp) / "inertia.csv"
         data_file(csv)
         if not args.before:
-            summary("now", run_tree(HERE.parent, args.runs, csv, args.pause))
+            summary("now", run_tree(HERE.parent, args.runs, csv, args.pause, args.choose))
             return
         old = Path(tmp) / "before"
         subprocess.run(["git", "worktree", "add", "--detach", str(old), args.before], cwd=HERE.parent,
@@ -226,7 +231,7 @@ def main():
             order = [HERE.parent, old, old, HERE.parent] if args.abba else [HERE.parent, old]
             results: dict = {HERE.parent: [], old: []}
             for tree in order:
-                results[tree] += run_tree(tree, args.runs, csv, args.pause)
+                results[tree] += run_tree(tree, args.runs, csv, args.pause, args.choose)
         finally:
             subprocess.run(["git", "worktree", "remove", "--force", str(old)], cwd=HERE.parent, check=False)
         ratio = summary("now", results[HERE.parent]) / summary(args.before[:10], results[old])
