@@ -5,7 +5,7 @@ asserts nothing.
 
 It serves the explorer of the working tree (``bushing serve --port 0``, reading the URL it
 prints), opens it in the system Chromium (headless), and ``--runs`` times: loads the page, opens
-*Find the missing effect*, waits ``--choose`` seconds (1 by default: a user choosing the file; the
+*Find the missing effect*, waits ``--choose`` seconds (0 by default; a user choosing the file, the
 page at rest after it), uploads 150 measured points (Paper B with a hidden 0.5 kg fixture
 mass, 30 frequencies × 5 amplitudes, 0.5 % noise: :func:`core.synthetic.synthetic_stiffness`),
 clicks *Diagnose* and measures, in the page (``performance.now()``, a MutationObserver), the
@@ -84,7 +84,7 @@ _WATCH_JS = """() => {
 }"""
 
 # the gap chart holds the report's bars: the baseline's and the found effect's (the chart is made,
-# hidden, with the baseline's bar alone when the tab opens)
+# hidden, with the baseline's bar alone when the data are loaded)
 DRAWN_JS = """(title) => [...Bokeh.documents[0].all_models].some(m => m.type === 'Figure' && m.title &&
   m.title.text === title && m.renderers.some(r => r.data_source && r.data_source.data &&
   Object.values(r.data_source.data).some(c => c && c.length > 1)))"""
@@ -118,15 +118,16 @@ def data_file(path: Path):
                         noise=0.005, seed=3).to_csv(path)
 
 
-def measure(page, url: str, csv: Path, pause: float = 0.0, choose: float = 1.0) -> dict:
+def measure(page, url: str, csv: Path, pause: float = 0.0, choose: float = 0.0) -> dict:
     """One diagnosis on a fresh page: seconds to the report drawn, to the first progress shown."""
     page.goto(url)
     page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0 && Bokeh.documents[0].is_idle",
                            timeout=120_000)
     page.get_by_text("Find the missing effect", exact=True).click()
     page.get_by_role("button", name="Diagnose").wait_for(timeout=60_000)
-    page.wait_for_timeout(1000 * choose)  # a user choosing the file (benchmark only)
-    page.wait_for_function("() => Bokeh.documents[0].is_idle", timeout=60_000)
+    if choose:
+        page.wait_for_timeout(1000 * choose)  # a user choosing the file (benchmark only)
+        page.wait_for_function("() => Bokeh.documents[0].is_idle", timeout=60_000)
     page.evaluate(UPLOAD_JS)
     page.locator("#main input[type=file]").last.set_input_files(str(csv))
     page.get_by_text("150 points").first.wait_for(timeout=60_000)
@@ -161,7 +162,7 @@ def metrics(cdp) -> dict:
     return {m["name"]: m["value"] for m in cdp.send("Performance.getMetrics")["metrics"]}
 
 
-def run_tree(tree: Path, runs: int, csv: Path, pause: float = 0.0, choose: float = 1.0) -> list[dict]:
+def run_tree(tree: Path, runs: int, csv: Path, pause: float = 0.0, choose: float = 0.0) -> list[dict]:
     from playwright.sync_api import sync_playwright
 
     proc, url = start_explorer(tree)
@@ -207,8 +208,8 @@ def main():
                         help="with --before: two batches of --runs for each tree, in the order now, before, before, now")
     parser.add_argument("--pause", type=float, default=0.0,
                         help="seconds between the data shown and the click (a user reading them); default 0")
-    parser.add_argument("--choose", type=float, default=1.0,
-                        help="seconds between the tab shown and the file handed over (a user choosing it); default 1")
+    parser.add_argument("--choose", type=float, default=0.0,
+                        help="seconds between the tab shown and the file handed over (a user choosing it); default 0")
     args = parser.parse_args()
     runs = 2 * args.runs if args.abba and args.before else args.runs
     print(f"diagnosis of 150 points in Chromium, median of {runs} runs (target ≤ {TARGET_S:.0f} s); "

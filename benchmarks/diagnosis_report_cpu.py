@@ -5,14 +5,13 @@ item 16): prints figures, asserts nothing.
 
 It runs the diagnosis of the browser benchmark's 150 points (``benchmarks/diagnose_browser.py``:
 Paper B with a hidden 0.5 kg fixture mass) once. Then ``--runs`` times, each in a new session
-built into a Bokeh document as a server would (the *Find the missing effect* tab shown, its
-report's plots made as a served page makes them after the tab opens, the data loaded, the
-document's pending work done): it stores that result as the tab does when its work
+built into a Bokeh document as a server would (the *Find the missing effect* tab shown, the data
+loaded, the document's pending work done): it stores that result as the tab does when its work
 ends (one held change) and serializes the held changes as the server's ``PATCH-DOC`` message.
 It prints the CPU time (``time.process_time``: this process only, other jobs on the machine do
 not count) of the first report of a session (what every page pays) and of a second one in the
-same session, with the Bokeh models each creates and the message's size, the CPU time of making
-the report's plots (when the tab opens) and that of loading the data. ``--profile`` adds
+same session, with the Bokeh models each creates and the message's size, and the CPU time of
+loading the data (what the tab makes ready for the report is made then). ``--profile`` adds
 cProfile's 25 costliest functions (cumulative) over the first reports. The library hooks of
 :func:`app.patches.install` are in place, as in a served explorer; ``--walk`` leaves out the one
 that attaches the models a change added (:mod:`app.patches.model_graph`): each change that adds
@@ -59,9 +58,6 @@ def session(csv: str):
     with set_curdoc(doc):
         app.template().server_doc(doc)
         app.tabs.active = next(i for i, (_t, name, _b) in enumerate(app.LAZY_TABS, 1) if name == "diagnosis")
-        t0 = time.process_time()
-        app.diagnosis.make_plots()  # what a served page does, one plot at a time, after the tab opens
-        app.plots_ms = 1e3 * (time.process_time() - t0)
         t0 = time.process_time()
         assert app.diagnosis.state.load_csv(csv, "inertia.csv")
         drain(doc)
@@ -132,17 +128,15 @@ def main(runs: int, profile: bool, walk: bool = False):
     result = app.diagnosis.state.compute()
     print(f"diagnosis of 150 points: {time.process_time() - t0:.2f} s CPU (once; not counted below)")
     prof = cProfile.Profile() if profile else None
-    first, second, load, plots = [], [], [], []
+    first, second, load = [], [], []
     report(*session(csv), result)  # warm: imports and caches
     for _ in range(runs):
         app, doc = session(csv)
         load.append(app.load_ms)
-        plots.append(app.plots_ms)
         first.append(report(app, doc, result, prof))
         second.append(report(app, doc, result))
-    print(f"  {'report plots made':<28} server CPU median {statistics.median(plots):6.1f} ms (as the tab opens)")
     print(f"  {'data loaded':<28} server CPU median {statistics.median(load):6.1f} ms (the upload's reading and "
-          "judging)")
+          "judging, and whatever the tab makes ready then)")
     for name, rows in (("first report of a session", first), ("second report, same session", second)):
         ms = [r[0] for r in rows]
         print(f"  {name:<28} server CPU median {statistics.median(ms):6.1f} ms (max {max(ms):6.1f}); "

@@ -7,8 +7,8 @@ asserts nothing.
 It serves the explorer of the working tree (``bushing serve --port 0``), opens it in the system
 Chromium (headless) and reads the CPU time of Chromium's processes (``/proc``: the renderer, which
 runs the page, and the others) over ``--seconds`` at rest: on the Explorer once it is drawn, and
-on *Find the missing effect* some seconds after 150 points were loaded there (its report's plots,
-made after the tab opened, hidden). ``--before REV`` measures a temporary ``git worktree`` of REV the same way.
+on *Find the missing effect* some seconds after 150 points were loaded there (its report's plots
+made ready meanwhile). ``--before REV`` measures a temporary ``git worktree`` of REV the same way.
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ def measure(tree: Path, seconds: float, csv: Path) -> dict[str, dict[str, float]
             page.get_by_text("Find the missing effect", exact=True).click()
             page.locator("#main input[type=file]").last.set_input_files(str(csv))
             page.get_by_text("150 points").first.wait_for(timeout=60_000)
-            time.sleep(2 * SETTLE_S)  # the report's plots made, the drop area's animations done
+            time.sleep(2 * SETTLE_S)  # the report's plots made ready, the drop area's animations done
             out["diagnosis tab, data loaded"] = at_rest(seconds)
             browser.close()
     finally:

@@ -74,16 +74,8 @@ def served(app_factory, **kwargs):
 
 
 def element(overlay, label: str):
-    """The element of ``overlay`` with ``label`` (each plotted curve has its own), or named
-    ``label`` in its "curve" column (a curve in a fixed place, labelled by the place:
-    :func:`app.plotting.style.named_curve`)."""
-
-    def named(el) -> bool:
-        if el.get_dimension("curve") is None or len(el) == 0:
-            return False
-        return set(el.dimension_values("curve")) == {label}
-
-    found = [el for el in overlay if el.label == label] or [el for el in overlay if named(el)]
+    """The element of ``overlay`` with ``label`` (each plotted curve has its own)."""
+    found = [el for el in overlay if el.label == label]
     assert len(found) == 1, f"{label!r} in {[el.label for el in overlay]}"
     return found[0]
 

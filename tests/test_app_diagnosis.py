@@ -178,11 +178,11 @@ def test_data_of_two_modes_are_diagnosed_jointly_and_plotted_in_the_explorers_mo
 
 
 def test_the_click_starts_the_work_then_makes_the_plots_not_ready_while_it_runs(app, monkeypatch):
-    """Diagnose clicked before the report's plots were made (on a served page they are made one
-    plot at a time after the tab opens; here, unserved, not before they are needed): the work is
-    started first, and the plots are made while it runs, one at a time in the page's order (the
-    work waits here until they are), then the report is written into them. On 5d78637 the click
-    made them before it started the work."""
+    """Diagnose clicked before the report's plots were made ready for the data (on a served page
+    they are made one plot at a time after the data are shown): the work is started first, and
+    the plots left are made while it runs, one at a time in the page's order (the work waits here
+    until they are), then the report is written into them. On 5d78637 the click made them before
+    it started the work."""
     import threading
 
     from app import work
@@ -213,6 +213,7 @@ def test_the_click_starts_the_work_then_makes_the_plots_not_ready_while_it_runs(
     monkeypatch.setattr(work, "_submit", submitted)
     monkeypatch.setattr(DiagnosisView, "_prepare", prepared)
     monkeypatch.setattr(DiagnosisState, "task", waits_for_the_plots)
+    monkeypatch.setattr(DiagnosisView, "_on_data", lambda self, *_e: setattr(self, "_ready", set()))
     view = app.diagnosis
     view.state.load_csv(inertia_csv())
     run(app)

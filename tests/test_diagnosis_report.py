@@ -1,7 +1,7 @@
-"""The diagnosis report's plots (issue #27, item 16): made, empty, when the tab opens, every
-report's numbers then written into them. Neither the data nor the report's push creates a Bokeh
-model or renders a HoloViews plot again, and what the report leaves in the models is what
-HoloViews draws from the report itself."""
+"""The diagnosis report's plots (issue #27, item 16): made while the data wait to be diagnosed,
+the report's numbers then written into them. The report's push creates no Bokeh model and renders
+no HoloViews plot again, and what it leaves in the models is what HoloViews draws from the
+report itself."""
 
 import numpy as np
 import pytest
@@ -23,21 +23,12 @@ def csv(frequencies, amplitudes, seed=3) -> str:
     return synthetic_stiffness(hidden, frequencies, amplitudes, noise=0.005, seed=seed).to_csv()
 
 
-def opened():
-    """A session's page in a Bokeh document, the diagnosis tab shown, its plots made (as a served
-    page makes them after the tab opens)."""
+def page(content: str):
+    """A session's page in a Bokeh document, the diagnosis tab shown, ``content`` loaded."""
     app, doc = App(), Document()
     with set_curdoc(doc):
         app.template().server_doc(doc)
         app.tabs.active = next(i for i, (_t, name, _b) in enumerate(app.LAZY_TABS, 1) if name == "diagnosis")
-        app.diagnosis.make_plots()
-    return app, doc
-
-
-def page(content: str):
-    """:func:`opened`, then ``content`` loaded."""
-    app, doc = opened()
-    with set_curdoc(doc):
         assert app.diagnosis.state.load_csv(content, "inertia.csv")
     return app, doc
 
@@ -113,20 +104,16 @@ def diagnosed():
     return content, app.diagnosis.state.compute()
 
 
-def test_the_report_is_written_into_plots_made_when_the_tab_opened(diagnosed):
-    """The tab's opening makes the report's plots (hidden, empty); loading the data, then the
-    report's push, create no Bokeh model and no HoloViews plot (on 63e5360: 560 models, seven
-    plots built after the work)."""
+def test_the_report_is_written_into_plots_made_for_the_data(diagnosed):
+    """Loading the data makes the report's plots (hidden); the report's push then creates no Bokeh
+    model and no HoloViews plot (on 63e5360: 560 models, seven plots built after the work)."""
     content, result = diagnosed
-    app, doc = opened()
+    app, doc = page(content)
     view = app.diagnosis
     assert not view._results.visible and set(view.live) == set(NAMES)
     plots = {name: plots_of(view.live[name]) for name in NAMES}
     assert all(len(p) == n for (name, p), n in zip(plots.items(), (1, 2, 4)))
     models = {m.id for m in doc.models}
-    with set_curdoc(doc):
-        assert view.state.load_csv(content, "inertia.csv")
-    assert {m.id for m in doc.models} == models
     push(app, doc, result)
     assert view._results.visible and "What is left is noise" in view.report.object
     assert {m.id for m in doc.models} == models

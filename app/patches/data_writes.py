@@ -5,8 +5,7 @@ styles, legend, linked axes, tap stream); a later frame with the same elements (
 styles, dimensions) differs only in its numbers, written into the Bokeh models
 HoloViews made: each changed element's columns (HoloViews' own ``get_data``) into its data source,
 a marker's position, the axis ranges (and the Reset tool's), the dimensions' words (after a mode
-switch) into the axis labels and tooltips, a bar chart's categories, a map's colour span, the
-columns of styles drawn from a dimension's values (the report's dots' colours); an axis
+switch) into the axis labels and tooltips, a bar chart's categories, a map's colour span; an axis
 HoloViews ranged from the data is kept while their extent is. The diagnosis report is written
 this way (``benchmarks/diagnosis_report_cpu.py``: 1 065 ms of server CPU and 560 new models per
 report before, 79 ms and none after); an amplitude change of the explorer 82 ms before, 31 ms
@@ -52,12 +51,6 @@ def _element_data(subplot, element) -> dict | None:
         if column and column not in data and hasattr(expr, "apply"):
             data[column] = np.asarray(expr.apply(element, flat=True))
     source = subplot.handles.get("source")
-    if source is not None:  # a style given as a dimension's name whose values are drawn as they are
-        style = subplot.lookup_options(element, "style").kwargs  # (colours): that dimension's values
-        for column in set(source.data) - set(data):
-            name = style.get(column)
-            if isinstance(name, str) and element.get_dimension(name) is not None:
-                data[column] = np.asarray(element.dimension_values(name))
     if source is None or set(data) != set(source.data):
         return None
     return data

@@ -7,7 +7,7 @@ from __future__ import annotations
 import holoviews as hv
 import numpy as np
 
-from .. import curves, report_curves
+from .. import curves, report_curves, units
 from .style import (
     amplitude_curves,
     dimensions,
@@ -24,27 +24,21 @@ def gap_bars(stages: dict, dims: dict) -> hv.Overlay:
     """The gap after each step of a diagnosis as bars, with the noise level (dashed)."""
     bars = styled("Bars", (list(stages["stage"]), np.asarray(stages["gap"], dtype=float)),
                   kdims=[dims["stage"]], vdims=[dims["gap"]], color="#3182bd", bar_width=0.6, tools=["hover"])
-    # the noise level's line is always there (not drawn where it is unknown: NaN), so that the plot
-    # has one shape for any diagnosis
-    noise = stages.get("noise")
-    items = [bars, styled("HLine", np.nan if noise is None else float(noise), kdims=[hv.Dimension("x"), dims["gap"]],
-                          color="#d62728", line_dash="dashed", line_width=2)]
+    items = [bars]
+    if stages.get("noise") is not None:
+        items.append(styled("HLine", float(stages["noise"]), kdims=[hv.Dimension("x"), dims["gap"]],
+                            color="#d62728", line_dash="dashed", line_width=2))
     return overlay(items, "Gap (relative RMS misfit of complex stiffness) after each step", "bushing-diagnosis-gap",
                    legend=None, height=230)
-
-
-# the report's curves per model: one per amplitude, of the most populated (app.report_curves.curve_groups)
-CURVE_PLACES = 5
 
 
 def diagnosis_curves(groups: list, dims: dict) -> dict:
     """Data (points) against the baseline (dashed) and the final model (solid), one colour per
     amplitude, for |K| and the loss factor (``groups`` as
-    :func:`app.report_curves.curve_groups`), in :data:`CURVE_PLACES` places per model whatever
-    the data (:func:`app.plotting.style.amplitude_curves`)."""
+    :meth:`app.diagnosis_state.DiagnosisState.curves`)."""
     return amplitude_curves(groups, dims, (("baseline", "baseline", {"line_dash": "dashed", "line_width": 1.5}),
                                            ("final", "final", {"line_width": 2})),
-                            "data, baseline and final model", "bushing-diagnosis", places=CURVE_PLACES)
+                            "data, baseline and final model", "bushing-diagnosis")
 
 
 def misfit_map(m: dict, column: str, title: str, dims: dict, limit: float, png: str) -> hv.Overlay:
@@ -69,18 +63,15 @@ def report_overlays(stages: dict, groups: list, misfits: dict, mode: str) -> dic
     quantity; ``misfits``: "baseline" and "final", each as :func:`app.report_curves.misfit_points`);
     ``"groups"`` the curves' amplitude groups."""
     base, final = misfits["baseline"], misfits["final"]
-    # every axis' range set from the data (none from HoloViews' own extent), so that the report's
-    # numbers can be written into plots made before (app.patches.written)
     ranges = {"gap": (0.0, 1.1 * max(float(np.max(stages["gap"])), stages["noise"] or 0.0) or 1.0),
-              "amplitude": curves.padded([final["amplitude"]], log=True),
-              "frequency": curves.padded([final["frequency_hz"]])}
+              "amplitude": curves.padded([final["amplitude"]], log=True)}
     for i, quantity in enumerate(("magnitude", "loss_factor")):  # the data and both models in view
         ranges[quantity] = curves.padded([v for g in groups for v in (g["data"][i], g["baseline"][i], g["final"][i])])
     dims = ranged(dimensions(mode), ranges)
     maps = []
     for which, m in (("baseline", base), ("final", final)):
         for column, name in (("magnitude_pct", "|K| misfit (%)"), ("loss_factor", "loss-factor misfit")):
-            limit = float(np.max(np.abs(base[column]), initial=0.0)) or 1.0  # one colour scale for before and after
+            limit = float(np.max(np.abs(base[column]))) or 1.0  # one colour scale for before and after
             maps.append(misfit_map(m, column, f"{which.capitalize()}: {name}", dims, limit,
                                    f"bushing-misfit-{which}-{MISFIT_PNG[column]}"))
     return {"gap": [gap_bars(stages, dims)], "curves": list(diagnosis_curves(groups, dims).values()),
@@ -94,12 +85,16 @@ def diagnosis_overlays(diagnosis) -> dict:
                            diagnosis.final.design.mode)
 
 
-def empty_overlays(mode: str) -> dict:
-    """The report's plots before any diagnosis, in ``mode``: the elements, labels and styles of
-    every report (:func:`report_overlays`) with no data. Built when the tab opens, never shown: a
-    report's numbers are then written into plots that exist (:meth:`app.live.LivePlot.show`)."""
-    none = {key: np.empty(0) for key in ("frequency_hz", "amplitude", "magnitude_pct", "loss_factor")}
-    return report_overlays({"stage": ["baseline"], "gap": np.zeros(1), "noise": None}, [],
+def pending_overlays(data, mode: str) -> dict:
+    """The plots a diagnosis of ``data`` (a :class:`core.data.MeasuredStiffness`, the rows of ``mode``)
+    will have, before it has run: the report's elements, labels and styles (one curve per measured
+    amplitude), both models standing at the data and no misfit. Built while the data wait to be
+    diagnosed, so that the report's numbers are then written into plots that exist
+    (:meth:`app.live.LivePlot.show`); never shown."""
+    groups = curves.amplitude_groups(data, mode, {"baseline": data.stiffness, "final": data.stiffness})
+    none = {"frequency_hz": data.frequency_hz, "amplitude": units.display_amplitude(data.amplitude, mode),
+            "magnitude_pct": np.zeros(len(data)), "loss_factor": np.zeros(len(data))}
+    return report_overlays({"stage": ["baseline"], "gap": np.zeros(1), "noise": 0.0}, groups,
                            {"baseline": none, "final": none}, mode)
 
 

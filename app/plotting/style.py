@@ -363,73 +363,24 @@ def sized(layout: hv.Layout, width: int | None) -> hv.Layout:
 
 
 
-# the columns of the curves and dots of :func:`amplitude_curves` in fixed places: each one's name,
-# as its tooltip gives it (the element's label names its place), and a dot's colour (drawn as given)
-CURVE_NAME = hv.Dimension("curve")
-CURVE_COLOUR = hv.Dimension("colour")
-
-
-def _named_tips(xdim: hv.Dimension, ydim: hv.Dimension) -> list:
-    """Tooltips that give the hovered item's :data:`CURVE_NAME`, then its x and y: one list for
-    the curves and dots of a plot, so that its one hover tool reads them all."""
-    return [("curve", f"@{{{CURVE_NAME.name}}}"), *((d.pprint_label, f"@{{{dimension_sanitizer(d.name)}}}") for d in (xdim, ydim))]
-
-
-def named_curve(x, y, xdim: hv.Dimension, ydim: hv.Dimension, place: str, name: str, **style):
-    """A curve labelled ``place`` whose tooltip gives ``name`` (a column of its own)."""
-    x = np.asarray(x, dtype=float)
-    return styled("Curve", (x, np.asarray(y, dtype=float), np.full(x.size, name, dtype=object)), kdims=[xdim],
-                  vdims=[ydim, CURVE_NAME], label=place, tools=["hover"], hover_tooltips=_named_tips(xdim, ydim),
-                  **style)
-
-
-def dots(sets: list, xdim: hv.Dimension, ydim: hv.Dimension, **style):
-    """Sets of points drawn as one element (one Bokeh scatter), each ``(x, y, name, colour)`` in
-    ``sets``; a tooltip gives the point's set."""
-    x = np.concatenate([np.asarray(s[0], dtype=float) for s in sets]) if sets else np.empty(0)
-    y = np.concatenate([np.asarray(s[1], dtype=float) for s in sets]) if sets else np.empty(0)
-    names = np.array([name for s in sets for name in [s[2]] * len(s[0])], dtype=object)
-    colours = np.array([colour for s in sets for colour in [s[3]] * len(s[0])], dtype=object)
-    return styled("Scatter", (x, y, names, colours), kdims=[xdim], vdims=[ydim, CURVE_NAME, CURVE_COLOUR],
-                  color=CURVE_COLOUR.name, tools=["hover"], hover_tooltips=_named_tips(xdim, ydim), **style)
-
-
-def amplitude_curves(groups: list, dims: dict, models: tuple, title: str, png: str, places: int | None = None) -> dict:
+def amplitude_curves(groups: list, dims: dict, models: tuple, title: str, png: str) -> dict:
     """Measured points and models against frequency, one colour per amplitude (the data as dots,
     each model a line at the same amplitude), for |K| and the loss factor. ``groups`` as
-    :func:`app.curves.amplitude_groups`; ``models``: (key in a group, label, line style) each.
-
-    ``places``: None, a curve per group and model and the dots of each group, labelled by their
-    amplitude (a tooltip names them by their label); a number, that many curves per model
-    whatever the groups (those past the groups empty) and the data's dots one element, each
-    labelled by its place and named in a column of its own (:func:`named_curve`, :func:`dots`):
-    plots of one shape for any data, built once and then written into (:mod:`app.live`)."""
+    :func:`app.curves.amplitude_groups`; ``models``: (key in a group, label, line style) each."""
     palette = SWEEP_PALETTES["amplitude"]
-    unit = dims["amplitude"].unit
-    colours = [palette[n % len(palette)] for n in range(max(len(groups), places or 0))]
-    labels = [sweep_label(g["amplitude"], unit) for g in groups]
     out = {}
     for i, (quantity, ydim) in enumerate((("magnitude", dims["magnitude"]), ("loss", dims["loss_factor"]))):
         items = []
-        if places is None:
-            for g, label, colour in zip(groups, labels, colours):
-                for key, name, style in models:
-                    if key in g:
-                        items.append(curve(g["frequency_hz"], g[key][i], dims["frequency"], ydim, f"{label} {name}",
-                                           color=colour, **style))
-                items.append(scatter(g["frequency_hz"], g["data"][i], dims["frequency"], ydim, f"{label} data",
-                                     color=colour, size=6, alpha=0.8))
-            if not items:  # no data: an empty plot (the view hides it)
-                items.append(scatter([], [], dims["frequency"], ydim, "data", color=palette[0], size=6))
-        else:
+        for n, g in enumerate(groups):
+            color = palette[n % len(palette)]
+            label = sweep_label(g["amplitude"], dims["amplitude"].unit)
             for key, name, style in models:
-                for n in range(places):
-                    g = groups[n] if n < len(groups) and key in groups[n] else None
-                    items.append(named_curve([] if g is None else g["frequency_hz"], [] if g is None else g[key][i],
-                                             dims["frequency"], ydim, f"{name} {n + 1}",
-                                             "" if g is None else f"{labels[n]} {name}", color=colours[n], **style))
-            items.append(dots([(g["frequency_hz"], g["data"][i], f"{label} data", colour)
-                               for g, label, colour in zip(groups[:places], labels, colours)],
-                              dims["frequency"], ydim, size=6, alpha=0.8))
+                if key in g:
+                    items.append(curve(g["frequency_hz"], g[key][i], dims["frequency"], ydim, f"{label} {name}",
+                                       color=color, **style))
+            items.append(scatter(g["frequency_hz"], g["data"][i], dims["frequency"], ydim, f"{label} data",
+                                 color=color, size=6, alpha=0.8))
+        if not items:  # no data: an empty plot (the view hides it)
+            items.append(scatter([], [], dims["frequency"], ydim, "data", color=palette[0], size=6))
         out[quantity] = overlay(items, f"{ydim.label}: {title}", f"{png}-{quantity}", legend=None, height=280)
     return out

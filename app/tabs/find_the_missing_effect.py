@@ -19,7 +19,7 @@ from core.numbers import format_number, format_value
 from ..diagnosis_state import DiagnosisState
 from ..inputs import tip
 from ..live import LivePlot, one_change, update_or_keep
-from ..plotting.find_the_missing_effect import diagnosis_overlays, empty_overlays
+from ..plotting.find_the_missing_effect import diagnosis_overlays, pending_overlays
 from ..plotting.style import SWEEP_PALETTES, sweep_label
 from ..shapes import shape_pane
 from ..units import amplitude_unit
@@ -55,10 +55,10 @@ def effect_units(effect: str, mode: str) -> dict[str, str]:
 PLOT_GROUPS = ("gap", "curves", "maps")  # the report's plots, in the order the page shows them
 PLOT_COLUMNS = {"gap": 1, "curves": 2, "maps": 2}
 PLOT_COUNTS = {"gap": 1, "curves": 2, "maps": 4}  # plots per group
-# the plots made one at a time, in the page's order: (group, index in it)
+# the plots made ready one at a time, in the page's order: (group, index in it)
 PREPARE_STEPS = tuple((name, i) for name in PLOT_GROUPS for i in range(PLOT_COUNTS[name]))
-# between two plots made (a served page): the event loop reads the page's messages meanwhile, so
-# that a file dropped or a click on *Diagnose* waits for the plot being built, not for every plot
+# between two plots made ready (a served page): the event loop reads the page's messages
+# meanwhile, so that a click on *Diagnose* waits for the plot being built, not for every plot
 # (a next-tick chain let them all run before the click's message was read: 1.4 s; a group at a
 # time, the click waited up to 0.9 s for the two curves)
 PREPARE_GAP_MS = 30
@@ -107,8 +107,9 @@ class DiagnosisView(pn.viewable.Viewer):
             callback=lambda: io.StringIO(state.predictions_csv()), filename="bushing-predictions.csv",
             label="Predictions (CSV)")
         self.live: dict[str, LivePlot] = {}  # "gap", "curves", "maps": built with the first data
-        self._ready: set[tuple[str, int]] = set()  # the plots made (PREPARE_STEPS)
-        self._overlays: dict | None = None  # what they were made with (empty_overlays)
+        self._prepared = 0  # how many data sets the plots were made ready for: a newer one stops an older
+        self._ready: set[tuple[str, int]] = set()  # the plots made ready for the loaded data (PREPARE_STEPS)
+        self._overlays: dict | None = None  # what they were made with (_pending)
         self._shown: dict[str, dict] = {}  # the overlays each group's LivePlot was last given
         self._ahead = None  # the diagnosis of the loaded data started ahead of the click (_on_data)
         # a place in the page for each plot, filled when the plot is first made (the grid never changes)
@@ -135,7 +136,6 @@ class DiagnosisView(pn.viewable.Viewer):
         state.param.watch(self._on_progress, ["progress", "progress_message"])
         state.param.watch(self._on_data, "data")
         self._refresh()
-        self._make_ahead()
 
     # ---- events --------------------------------------------------------------------------------
 
@@ -162,10 +162,10 @@ class DiagnosisView(pn.viewable.Viewer):
     async def _diagnose(self):
         """The diagnosis in a worker process (a thread in an unserved app), its steps shown as they
         come (:func:`app.work.in_thread`); the report and its plots replace the progress in one
-        push. The plots not yet made (a click as soon as the tab opens) are made on the server
-        while the work runs, one at a time, the work started first: measured with
-        ``benchmarks/diagnose_browser.py``, making them before the work (5d78637) added their 0.9 s
-        of the server's CPU to the wait. A page closed meanwhile gets nothing more."""
+        push. The plots not yet made ready for the data (a click as soon as they are
+        shown) are made on the server while the work runs, one at a time, the work started first:
+        measured with ``benchmarks/diagnose_browser.py``, making them before the work (5d78637)
+        added their 0.9 s of the server's CPU to the wait. A page closed meanwhile gets nothing more."""
         state, ahead, self._ahead = self.state, self._ahead, None
         unready = [partial(self._prepare, *step) for step in PREPARE_STEPS if step not in self._ready]
         try:  # in a worker process when the server has them (app.work.use_processes)
@@ -195,9 +195,20 @@ class DiagnosisView(pn.viewable.Viewer):
                                      if s.running else "")
 
     def _on_data(self, *_events):
-        """New data: their diagnosis starts at once in an idle worker process, if the server has
+        """New data: the report's plots are made ready for them once the data are on the page
+        (:meth:`_prepare`; on a served page the data's message goes first, then one plot every
+        :data:`PREPARE_GAP_MS`, so that a click on *Diagnose* waits for one plot at most; the
+        plots left are made while the diagnosis runs: :meth:`_diagnose`).
+
+        The diagnosis of the new data starts at once in an idle worker process, if the server has
         one (:func:`app.work.start_ahead`): the click takes it over if nothing it depends on
-        changed meanwhile (the design, the baseline), else starts its own."""
+        changed meanwhile (the design, the baseline), else starts its own.
+
+        Measured and left (2026-12-06): the plots made when the tab opens instead, in one shape
+        for any data, made a click at once faster (2.43 s against 3.05 s) but the data's line
+        slower (0.48-0.80 s against 0.17 s with the file handed over 1-4 s after the tab shows:
+        the browser handles the plots' messages, in order, before the data's, and lays out a page
+        that holds them; README, "Speed")."""
         cancel(self._ahead)
         self._ahead = None
         if self.state.data is not None and not self.state.running:
@@ -205,50 +216,55 @@ class DiagnosisView(pn.viewable.Viewer):
                 self._ahead = start_ahead(self.state.task())
             except ValueError:
                 pass  # the data cannot be diagnosed as they are: the click says why
+        self._prepared += 1
+        self._ready, self._overlays = set(), None
+        generation, doc = self._prepared, pn.state.curdoc
+        served = doc is not None and doc.session_context is not None
 
-    def _make_ahead(self):
-        """The report's plots made as the tab opens, hidden and empty (:meth:`make_plots`): every
-        report is then written into them (:meth:`app.live.LivePlot.show`; their shape is the same
-        for any data: :func:`app.plotting.find_the_missing_effect.empty_overlays`). On a served
-        page one plot every :data:`PREPARE_GAP_MS` after the tab is shown, so that the tab answers
-        at once and a file dropped or a click meanwhile waits for one plot at most; those left at
-        a click are made while its work runs (:meth:`_diagnose`). Made with the data instead, they
-        took the server about 1 s of CPU, and the browser as much, while the diagnosis started
-        with the data ran (``benchmarks/diagnose_browser.py``). Unserved (a script, a notebook):
-        made when first needed."""
-        doc = pn.state.curdoc
-        if doc is None or doc.session_context is None:
-            return
-
-        def make(i: int):
-            if i >= len(PREPARE_STEPS) or not page_open(doc):
-                return  # every plot is made, or the page closed
+        def prepare(i: int):
+            s = self.state
+            if (generation != self._prepared or i >= len(PREPARE_STEPS) or s.running or s.result is not None
+                    or not page_open(doc)):
+                return  # newer data came, every plot is made, the click makes the rest, or the page closed
             self._prepare(*PREPARE_STEPS[i])
-            doc.add_timeout_callback(lambda: make(i + 1), PREPARE_GAP_MS)
+            if served:
+                doc.add_timeout_callback(lambda: prepare(i + 1), PREPARE_GAP_MS)
+            else:
+                prepare(i + 1)
 
-        doc.add_next_tick_callback(lambda: make(0))
-
-    def make_plots(self):
-        """Every report plot not yet made, made now (hidden until a report)."""
-        for step in PREPARE_STEPS:
-            self._prepare(*step)
+        if served:
+            doc.add_next_tick_callback(lambda: prepare(0))
+        else:
+            prepare(0)
 
     def _prepare(self, name: str, index: int):
-        """The plot ``index`` of the group ``name`` of the report's plots made, empty, once (the
-        group's plots before it too)."""
+        """The plot ``index`` of the group ``name`` of the report's plots made ready for the loaded
+        data, once (the group's plots before it too)."""
         if (name, index) in self._ready:
             return
         if self._overlays is None:
-            self._overlays = empty_overlays(self.state.explorer.design.mode)
-        update_or_keep("DiagnosisView made no plots", lambda: self._plot(name, self._overlays, index + 1))
+            self._overlays = self._pending()
+            if self._overlays is None:
+                return
+        update_or_keep("DiagnosisView prepared no plots", lambda: self._plot(name, self._overlays, index + 1))
         self._ready.update((name, i) for i in range(index + 1))
+
+    def _pending(self) -> dict | None:
+        """The report's plots with the shape a diagnosis of the loaded data will give them
+        (:func:`app.plotting.find_the_missing_effect.pending_overlays`): the report then writes its
+        numbers into them (:meth:`app.live.LivePlot.show`) instead of HoloViews building seven
+        plots after the work (measured: ``benchmarks/diagnosis_report_cpu.py``). None without data."""
+        s = self.state
+        data = None if s.data is None else s.data.of_mode(s.explorer.design.mode)
+        if data is None or len(data) == 0:
+            return None
+        return pending_overlays(data, s.explorer.design.mode)
 
     def _plots(self, overlays: dict):
         """``overlays`` (as :func:`app.plotting.find_the_missing_effect.report_overlays`) shown in
         the report's plots, built the first time."""
         for name in PLOT_GROUPS:
             self._plot(name, overlays)
-        self._ready.update(PREPARE_STEPS)  # every plot in its place: none is to be made empty any more
 
     def _plot(self, name: str, overlays: dict, count: int | None = None):
         """The group ``name`` of the report's plots showing ``overlays[name]``, its first ``count``
