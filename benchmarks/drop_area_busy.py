@@ -20,7 +20,6 @@ from __future__ import annotations
 import argparse
 import signal
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -29,38 +28,30 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+from app_latency import chromium_cpu  # CPU seconds of Chromium's processes, by type (/proc)
 from diagnose_browser import CHROMIUM, data_file
 from servers import start_explorer
 
-# every drop area's items' states, through the shadow roots
-STATES_JS = """() => { const out = []; const walk = (root) => {
-  for (const el of root.querySelectorAll('[data-filepond-item-state]')) out.push(el.getAttribute('data-filepond-item-state'));
-  for (const el of root.querySelectorAll('*')) if (el.shadowRoot) walk(el.shadowRoot); };
-  walk(document); return out.join(','); }"""
+# the document and every shadow root in it, each given to f (the page's components each have one)
+ROOTS_JS = """const roots = (f) => { const walk = (root) => { f(root);
+  for (const el of root.querySelectorAll('*')) if (el.shadowRoot) walk(el.shadowRoot); }; walk(document); };"""
+# every drop area's items' states
+STATES_JS = f"""() => {{ {ROOTS_JS} const out = [];
+  roots(r => {{ for (const el of r.querySelectorAll('[data-filepond-item-state]')) out.push(el.getAttribute('data-filepond-item-state')); }});
+  return out.join(','); }}"""
 # the ring held still, a rule in every drop area's shadow root
-STILL_JS = """() => { const walk = (root) => { for (const el of root.querySelectorAll('*')) if (el.shadowRoot) {
-  if (el.shadowRoot.querySelector('.filepond--root')) { const s = new CSSStyleSheet();
-    s.replaceSync(".filepond--progress-indicator svg { animation: none !important; }");
-    el.shadowRoot.adoptedStyleSheets = [...el.shadowRoot.adoptedStyleSheets, s]; }
-  walk(el.shadowRoot); } }; walk(document); }"""
-
+STILL_JS = f"""() => {{ {ROOTS_JS} roots(r => {{ if (r !== document && r.querySelector('.filepond--root')) {{
+  const s = new CSSStyleSheet(); s.replaceSync(".filepond--progress-indicator svg {{ animation: none !important; }}");
+  r.adoptedStyleSheets = [...r.adoptedStyleSheets, s]; }} }}); }}"""
 # how many of the page's animations turn a ring now
-SPINS_JS = """() => { let n = 0; const walk = (root) => {
-  n += root.getAnimations().filter(a => a.animationName === 'spin' && a.playState === 'running').length;
-  for (const el of root.querySelectorAll('*')) if (el.shadowRoot) walk(el.shadowRoot); };
-  walk(document); return n; }"""
+SPINS_JS = f"""() => {{ {ROOTS_JS} let n = 0;
+  roots(r => {{ n += r.getAnimations().filter(a => a.animationName === 'spin' && a.playState === 'running').length; }});
+  return n; }}"""
 
 
-def chromium_cpu() -> float:
-    """CPU seconds of every Chromium process so far."""
-    total = 0
-    for pid in subprocess.run(["pgrep", "-f", "chromium"], check=False, capture_output=True, text=True).stdout.split():
-        try:
-            fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        total += int(fields[11]) + int(fields[12])
-    return total / 100
+def browser_cpu() -> float:
+    """CPU seconds of every Chromium process so far (app_latency.chromium_cpu, all types)."""
+    return sum(chromium_cpu().values())
 
 
 def upload(page, url: str, csv: Path, still: bool) -> dict:
@@ -72,13 +63,13 @@ def upload(page, url: str, csv: Path, still: bool) -> dict:
     if still:
         page.evaluate(STILL_JS)
     page.wait_for_timeout(1000)
-    cpu, start = chromium_cpu(), time.perf_counter()
+    cpu, start = browser_cpu(), time.perf_counter()
     page.locator("#main input[type=file]").last.set_input_files(str(csv))
     page.get_by_text("150 points").first.wait_for(timeout=60_000)
     shown = time.perf_counter() - start
     spins = page.evaluate(SPINS_JS)
     page.wait_for_function(f"() => ({STATES_JS})().includes('processing-complete')", polling=50, timeout=60_000)
-    return {"spins": spins, "shown": shown, "busy": time.perf_counter() - start, "cpu": chromium_cpu() - cpu}
+    return {"spins": spins, "shown": shown, "busy": time.perf_counter() - start, "cpu": browser_cpu() - cpu}
 
 
 def main():
