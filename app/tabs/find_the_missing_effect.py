@@ -55,6 +55,17 @@ def effect_units(effect: str, mode: str) -> dict[str, str]:
 PLOT_GROUPS = ("gap", "curves", "maps")  # the report's plots, in the order the page shows them
 PLOT_COLUMNS = {"gap": 1, "curves": 2, "maps": 2}
 PLOT_COUNTS = {"gap": 1, "curves": 2, "maps": 4}  # plots per group
+# the groups in a tab of the report not shown first: a click on *Diagnose* before they were made
+# ready for the data makes them after the report is on the page, not while the work runs
+# (measured with benchmarks/diagnose_browser.py: the four maps made meanwhile held a click at
+# once 4.10 s against 2.55 s without them)
+LATER_GROUPS = ("maps",)
+REPORT_TABS = ("Data and models", "Where they disagree: misfit maps")
+# from a report's message to the first of its later plots put in the page: the browser lays out
+# and paints the report first (0.2-0.6 s, diagnose_browser.py). A plot sent sooner was handled
+# before the report's frame: that frame came 0.58 s after its message instead of 0.21 s. Opening
+# the tab puts them there at once.
+LATER_AFTER_MS = 1000
 # the plots made ready one at a time, in the page's order: (group, index in it)
 PREPARE_STEPS = tuple((name, i) for name in PLOT_GROUPS for i in range(PLOT_COUNTS[name]))
 # between two plots made ready (a served page): the event loop reads the page's messages
@@ -117,16 +128,24 @@ class DiagnosisView(pn.viewable.Viewer):
                        for name in PLOT_GROUPS}
         self._plot_holders = {name: pn.GridBox(*self._slots[name], ncols=PLOT_COLUMNS[name], sizing_mode="stretch_width")
                               for name in PLOT_GROUPS}
+        # the curves and the maps in two tabs of the report: the maps' tab is laid out and painted
+        # only when opened (its plots are made while it is hidden)
+        self.report_tabs = pn.Tabs(
+            (REPORT_TABS[0], pn.Column(
+                "**Data (points) against the baseline (dashed) and the final model (solid)**",
+                self.curve_key, self._plot_holders["curves"], sizing_mode="stretch_width")),
+            (REPORT_TABS[1], pn.Column(
+                "**Misfit over the (frequency, amplitude) plane**, model − data: the baseline above, the "
+                "final model below, on the same colour scale", self._plot_holders["maps"],
+                sizing_mode="stretch_width")),
+            sizing_mode="stretch_width")
+        self.report_tabs.param.watch(self._on_tab, "active")
+        self._later: dict | None = None  # the overlays whose LATER_GROUPS plots wait to be placed
         self._results = pn.Column(
             "### 3. What the diagnosis found",
             self.report,
             self._plot_holders["gap"],
-            "**Data (points) against the baseline (dashed) and the final model (solid)**",
-            self.curve_key,
-            self._plot_holders["curves"],
-            "**Misfit over the (frequency, amplitude) plane**, model − data: the baseline above, the final "
-            "model below, on the same colour scale",
-            self._plot_holders["maps"],
+            self.report_tabs,
             "### 4. Take it further",
             pn.Row(self.use, self.reveal, self.download_report, self.download_predictions),
             self.truth,
@@ -155,6 +174,7 @@ class DiagnosisView(pn.viewable.Viewer):
         """The progress set for a diagnosis; False if one runs already."""
         if self.state.running:
             return False
+        self._later = None  # the last report's plots left to place: this diagnosis' report places its own
         self.state.param.update(running=True, message="", result=None, revealed=False, progress=0.0,
                                 progress_message="fitting the baseline")
         return True
@@ -162,12 +182,15 @@ class DiagnosisView(pn.viewable.Viewer):
     async def _diagnose(self):
         """The diagnosis in a worker process (a thread in an unserved app), its steps shown as they
         come (:func:`app.work.in_thread`); the report and its plots replace the progress in one
-        push. The plots not yet made ready for the data (a click as soon as they are
-        shown) are made on the server while the work runs, one at a time, the work started first:
-        measured with ``benchmarks/diagnose_browser.py``, making them before the work (5d78637)
-        added their 0.9 s of the server's CPU to the wait. A page closed meanwhile gets nothing more."""
+        push. The plots of the report's first tab not yet made ready for the data (a click as soon
+        as they are shown) are made on the server while the work runs, one at a time, the work
+        started first: measured with ``benchmarks/diagnose_browser.py``, making them before the
+        work (5d78637) added their 0.9 s of the server's CPU to the wait. Those of
+        :data:`LATER_GROUPS` are made after the report is shown (:meth:`_plots`). A page closed
+        meanwhile gets nothing more."""
         state, ahead, self._ahead = self.state, self._ahead, None
-        unready = [partial(self._prepare, *step) for step in PREPARE_STEPS if step not in self._ready]
+        unready = [partial(self._prepare, *step) for step in PREPARE_STEPS
+                   if step not in self._ready and step[0] not in LATER_GROUPS]
         try:  # in a worker process when the server has them (app.work.use_processes)
             work = claim(ahead, state.task())  # the diagnosis started with the data, if it is this one
             result = await in_thread(work, self._show_progress, pn.state.curdoc, meanwhile=unready)
@@ -210,7 +233,7 @@ class DiagnosisView(pn.viewable.Viewer):
         the browser handles the plots' messages, in order, before the data's, and lays out a page
         that holds them; README, "Speed")."""
         cancel(self._ahead)
-        self._ahead = None
+        self._ahead, self._later = None, None
         if self.state.data is not None and not self.state.running:
             try:
                 self._ahead = start_ahead(self.state.task())
@@ -262,9 +285,48 @@ class DiagnosisView(pn.viewable.Viewer):
 
     def _plots(self, overlays: dict):
         """``overlays`` (as :func:`app.plotting.find_the_missing_effect.report_overlays`) shown in
-        the report's plots, built the first time."""
+        the report's plots, built the first time. On a served page, the plots of
+        :data:`LATER_GROUPS` not yet in the page are put there after this change has gone to the
+        browser, :data:`LATER_AFTER_MS` after it or when their tab is opened, one every
+        :data:`PREPARE_GAP_MS` (:meth:`_place_later`): the report's message and its first frame
+        wait for none of them."""
+        doc = pn.state.curdoc
+        served = doc is not None and doc.session_context is not None
         for name in PLOT_GROUPS:
-            self._plot(name, overlays)
+            if served and name in LATER_GROUPS:
+                self._plot(name, overlays, self._placed(name))  # the numbers into those in the page
+            else:
+                self._plot(name, overlays)
+        later = served and any(self._placed(name) < PLOT_COUNTS[name] for name in LATER_GROUPS)
+        self._later = overlays if later else None
+        if later:
+            if self.report_tabs.active == 0:
+                doc.add_timeout_callback(partial(self._place_later, doc, overlays), LATER_AFTER_MS)
+            else:
+                doc.add_next_tick_callback(partial(self._place_later, doc, overlays))
+
+    def _placed(self, name: str) -> int:
+        """How many plots of group ``name`` are in the page."""
+        return sum(1 for slot in self._slots[name] if slot.objects)
+
+    def _place_later(self, doc, overlays: dict):
+        """One plot of :data:`LATER_GROUPS` not yet in the page put there, then the next one
+        :data:`PREPARE_GAP_MS` later, while ``overlays`` is still the report's to place (newer
+        data or a newer report take over) and the page is open."""
+        if self._later is not overlays or not page_open(doc):
+            return
+        name = next((n for n in LATER_GROUPS if self._placed(n) < PLOT_COUNTS[n]), None)
+        if name is None:
+            self._later = None
+            return
+        update_or_keep("DiagnosisView placed no plot", lambda: self._plot(name, overlays, self._placed(name) + 1))
+        doc.add_timeout_callback(partial(self._place_later, doc, overlays), PREPARE_GAP_MS)
+
+    def _on_tab(self, event):
+        """The maps' tab opened while its plots wait to be placed: placed from now on."""
+        doc = pn.state.curdoc
+        if event.new != 0 and self._later is not None and doc is not None and doc.session_context is not None:
+            doc.add_next_tick_callback(partial(self._place_later, doc, self._later))
 
     def _plot(self, name: str, overlays: dict, count: int | None = None):
         """The group ``name`` of the report's plots showing ``overlays[name]``, its first ``count``
