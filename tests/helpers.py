@@ -1,6 +1,7 @@
 """Small helpers shared by tests: the command line run in process, a server started."""
 
 import asyncio
+import concurrent.futures
 import contextlib
 import queue
 import threading
@@ -25,6 +26,23 @@ def fetch(url: str, timeout: float = 60.0) -> bytes:
     with urllib.request.urlopen(url, timeout=timeout) as r:
         assert r.status == 200, (url, r.status)
         return r.read()
+
+
+def off_the_loop(function, *args):
+    """``function(*args)``; in a thread of its own when this thread runs an event loop (a test
+    process that ran a browser test: Playwright's synchronous API keeps one running in the main
+    thread), where ``asyncio.run`` and a second ``sync_playwright()`` refuse to start."""
+    try:
+        asyncio.get_running_loop()
+    except RuntimeError:
+        return function(*args)
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        return pool.submit(function, *args).result()
+
+
+def run_async(coro):
+    """``asyncio.run(coro)`` in any test process (:func:`off_the_loop`)."""
+    return off_the_loop(asyncio.run, coro)
 
 
 @contextlib.contextmanager

@@ -12,7 +12,7 @@ import pytest
 
 from app import admission, patches
 from app.main import create_app
-from tests.helpers import served
+from tests.helpers import off_the_loop, served
 
 
 def test_the_refusal_names_the_limit_reached():
@@ -94,7 +94,7 @@ def test_a_page_beyond_the_sessions_held_is_told_the_server_is_busy(admitting):
         assert admission.RETRY_S[0] <= int(headers["Retry-After"]) <= admission.RETRY_S[1]
         assert "The server is busy" in body and "holds 2 sessions" in body
         with pytest.raises(OSError, match="503"):  # a new session by websocket alone
-            pull_session(url=url)
+            off_the_loop(lambda: pull_session(url=url))  # bokeh.client's own loop
         assert len(server.get_sessions()) == 2  # nothing built for the refusals
         assert get(url + "liveness")[0] == 200
         assert admitting.refused == 2

@@ -1,6 +1,5 @@
 """The "Find the missing effect" tab without a browser: the data its plots hold against the core."""
 
-import asyncio
 import csv
 import io
 import itertools
@@ -13,7 +12,7 @@ from app.main import App
 from core import PAPER_B, stiffness, stiffness_points
 from core.numbers import format_value
 from core.synthetic import MYSTERIES, synthetic_stiffness
-from tests.helpers import element, xy
+from tests.helpers import element, run_async, xy
 
 F = np.linspace(1, 100, 30)
 AMPS = (0.013e-3, 0.04e-3, 0.1e-3, 0.17e-3, 0.35e-3)
@@ -29,7 +28,7 @@ def inertia_csv() -> str:
 
 
 def run(app):
-    asyncio.run(app.diagnosis._run(None))
+    run_async(app.diagnosis._run(None))
 
 
 def test_every_mystery_is_diagnosed_right():

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from app.deploy import nginx_config
-from tests.helpers import fetch
+from tests.helpers import fetch, off_the_loop
 
 NGINX = shutil.which("nginx") or ("/usr/sbin/nginx" if Path("/usr/sbin/nginx").exists() else None)
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -77,24 +77,28 @@ def test_sessions_on_both_processes_through_nginx(balanced):
     if CHROMIUM is None:
         pytest.fail("Chromium is not installed (apt-get install -y chromium)")
     url = f"http://127.0.0.1:{front}/"
-    with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=[
-            "--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update",
-            "--disable-sync", "--no-first-run", "--disable-quic"])
-        pages = []
-        for route in ("alpha", "beta", "gamma", "delta", "epsilon", "zeta"):
-            context = browser.new_context(viewport={"width": 1400, "height": 1100})
-            context.add_cookies([{"name": "bushing_route", "value": route, "url": url}])
-            page = context.new_page()
-            page.goto(url)
-            page.locator(".bk-Canvas").nth(4).wait_for(timeout=60000)
-            pages.append(page)
-        for i, page in enumerate(pages):  # each session answers a change of its own
-            field = page.get_by_label("Length L (mm)")
-            field.fill(str(80 + i))
-            field.press("Enter")
-            page.wait_for_url(f"**L_mm={80 + i}**", timeout=20000)
-        browser.close()
+
+    def six_sessions():  # a Playwright of its own, off any browser test's event loop
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path=CHROMIUM, args=[
+                "--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update",
+                "--disable-sync", "--no-first-run", "--disable-quic"])
+            pages = []
+            for route in ("alpha", "beta", "gamma", "delta", "epsilon", "zeta"):
+                context = browser.new_context(viewport={"width": 1400, "height": 1100})
+                context.add_cookies([{"name": "bushing_route", "value": route, "url": url}])
+                page = context.new_page()
+                page.goto(url)
+                page.locator(".bk-Canvas").nth(4).wait_for(timeout=60000)
+                pages.append(page)
+            for i, page in enumerate(pages):  # each session answers a change of its own
+                field = page.get_by_label("Length L (mm)")
+                field.fill(str(80 + i))
+                field.press("Enter")
+                page.wait_for_url(f"**L_mm={80 + i}**", timeout=20000)
+            browser.close()
+
+    off_the_loop(six_sessions)
     fetch(f"http://127.0.0.1:{front}/liveness", timeout=10)  # 200 through nginx after the sessions, or it raises
     # a graceful stop: nginx exits once every connection has ended, each logged when it ends
     # (a websocket's line is written when it closes)

@@ -7,7 +7,7 @@ check interval and a margin, and ends as soon as the server holds no session."""
 import time
 
 from app.main import SESSION_CHECK_S, SESSION_LIFETIME_S, SESSION_OPTIONS, create_app
-from tests.helpers import served
+from tests.helpers import off_the_loop, served
 
 MARGIN_S = 20  # a loaded machine's event loop may run the check late
 
@@ -21,10 +21,15 @@ def test_closed_sessions_are_discarded_after_the_lifetime():
 
     with served(create_app, verbose=False, **SESSION_OPTIONS) as server:
         url = f"http://localhost:{server.port}/"
-        pulled = [pull_session(url=url) for _ in range(2)]
-        assert sessions(server) == 2
-        for session in pulled:
-            session.close()
+
+        def two_pages():  # bokeh.client runs a loop of its own: off any browser test's (off_the_loop)
+            pulled = [pull_session(url=url) for _ in range(2)]
+            held = sessions(server)
+            for session in pulled:
+                session.close()
+            return held
+
+        assert off_the_loop(two_pages) == 2
         closed = time.monotonic()
         bound = SESSION_LIFETIME_S + SESSION_CHECK_S + MARGIN_S
         while sessions(server) and time.monotonic() - closed < bound:

@@ -15,6 +15,7 @@ from app import work
 from core import PAPER_B
 from core.identify.diagnose import diagnose
 from core.synthetic import synthetic_stiffness
+from tests.helpers import run_async
 
 
 @pytest.fixture
@@ -52,7 +53,7 @@ def refuse(progress=None):
 
 
 def run(task, shown=None):
-    return asyncio.run(work.in_thread(task, None if shown is None else lambda f, m: shown.append((f, m))))
+    return run_async(work.in_thread(task, None if shown is None else lambda f, m: shown.append((f, m))))
 
 
 def test_a_task_runs_in_another_process_and_a_plain_function_in_this_one(processes):
@@ -111,7 +112,7 @@ def test_work_started_ahead_is_taken_over_by_the_same_work(processes):
         assert work.claim(started, work.Task(token)) is started
         return started, await work.in_thread(work.claim(started, work.Task(token)))
 
-    started, got = asyncio.run(click())
+    started, got = run_async(click())
     assert got == started.future.result()  # one run, not a second
 
 
@@ -125,7 +126,7 @@ def test_work_started_ahead_gives_way_to_other_work(processes):
         assert work.claim(other, work.Task(count_to, (10**6 + 1,))) == work.Task(count_to, (10**6 + 1,))
         return ahead, other, pid
 
-    ahead, other, pid = asyncio.run(others())
+    ahead, other, pid = run_async(others())
     assert pid != os.getpid()
     for started in (ahead, other):
         assert started.future.cancelled() or isinstance(started.future.exception(timeout=120), work.Cancelled)
@@ -138,12 +139,12 @@ def test_a_diagnosis_click_takes_over_the_diagnosis_started_with_the_data_if_not
     assert view.state.load_csv(data().to_csv(), "inertia.csv")
     started = view._ahead
     assert started is not None
-    asyncio.run(view._run())
+    run_async(view._run())
     assert view.state.result is started.future.result() and view.state.result.added == ["inertia"]
     # the baseline changed after the data came: the click diagnoses with the new one
     assert view.state.load_csv(data().to_csv(), "inertia.csv")
     view.state.baseline = ["elastic", "friction"]
-    asyncio.run(view._run())
+    run_async(view._run())
     assert view.state.result.baseline.model.branches == ("elastic", "friction")
 
 
@@ -158,6 +159,6 @@ def test_work_started_ahead_that_ended_unclaimed_is_held_only_by_whoever_started
         await work.in_thread(work.Task(pid_of))  # and other work after it
         return weakref.ref(started), started.future.result()
 
-    ref, got = asyncio.run(unclaimed())
+    ref, got = run_async(unclaimed())
     gc.collect()
     assert ref() is None and len(got) == 8
