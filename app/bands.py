@@ -154,8 +154,7 @@ def tolerances_of(key: tuple) -> Tolerances:
 
 def _shown(name: str, value: float) -> str:
     """``value`` (SI) of parameter ``name`` in its display unit: ``17.5 mm``."""
-    unit = BY_NAME[name].unit
-    return f"{format_number(unit.to_display(value), 4)} {unit.display}".rstrip()
+    return BY_NAME[name].unit.shown(value, 4)
 
 
 def tolerance_refusal(tolerance_pct: dict[str, float], design: Design) -> tuple[tuple[str, ...], str]:

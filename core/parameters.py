@@ -22,6 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .numbers import format_number
+
 
 @dataclass(frozen=True)
 class Unit:
@@ -38,6 +40,12 @@ class Unit:
     def to_display(self, value):
         """``value`` in SI, in display units (arrays too; complex kept)."""
         return np.asarray(value) / self.factor
+
+    def shown(self, value: float, digits: int = 3) -> str:
+        """``value`` (SI) as people read it: in the display unit, to ``digits`` significant
+        digits (:func:`core.numbers.format_number`): ``3.55 MPa``; a pure number alone."""
+        text = format_number(float(self.to_display(value)), digits)
+        return text if self.display == "–" else f"{text} {self.display}"
 
 
 @dataclass(frozen=True)

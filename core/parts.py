@@ -132,13 +132,12 @@ def check_bulk_ratio(material: Material) -> None:
     ratio = material.bulk_modulus / material.shear_modulus
     if not low <= ratio <= high:
         k, mu = BY_NAME["bulk_modulus"].unit, BY_NAME["shear_modulus"].unit
-        shown = lambda value, unit: f"{format_number(unit.to_display(value), 3)} {unit.display}"
         raise DesignError(
             "material.bulk_modulus",
             f"must lie between {low:g} and {format_number(high)} times the shear modulus (Poisson's ratio 0.49 to "
-            f"0.4999995; filled rubber has about 2 GPa): with µ = {shown(material.shear_modulus, mu)}, "
-            f"{shown(low * material.shear_modulus, k)} to {shown(high * material.shear_modulus, k)}; got "
-            f"{shown(material.bulk_modulus, k)} (K/µ = {format_number(ratio, 3)})", OUT_OF_RANGE)
+            f"0.4999995; filled rubber has about 2 GPa): with µ = {mu.shown(material.shear_modulus)}, "
+            f"{k.shown(low * material.shear_modulus)} to {k.shown(high * material.shear_modulus)}; got "
+            f"{k.shown(material.bulk_modulus)} (K/µ = {format_number(ratio, 3)})", OUT_OF_RANGE)
 
 
 def as_dict(value) -> dict[str, float]:

@@ -94,6 +94,21 @@ def test_a_side_that_spends_its_evaluations_is_open_and_the_profile_says_so():
     assert cut.evaluations <= 4 * 3 + 1
 
 
+def test_a_material_bound_is_worded_in_the_unit_of_its_field():
+    """A sweep at one amplitude cannot fix µ apart from the friction branch: the warning gives
+    µ's bound in MPa, the unit of its field in the explorer, from the one formatter (issue #27,
+    items 5 and 7; it read "any value up to 3550000 Pa"); ε½, a pure number, stays bare."""
+    design = read_design(EXAMPLES / "paper_b_guess.json")
+    result = fit_global(design, read_stiffness(EXAMPLES / "paper_b_sweep_0.1mm.csv"))
+    low, high = result.intervals["shear_modulus"]
+    assert low is None and high is not None
+    text = " ".join(result.warnings)
+    assert f"shear_modulus is not determined by these data: any value up to {format_number(high / 1e6, 3)} MPa fits" in text
+    assert " Pa " not in text and "000 " not in text
+    low, high = result.intervals["friction_strain_half"]
+    assert f"friction_strain_half is not determined by these data: any value up to {format_number(high, 3)} fits" in text
+
+
 def test_a_parameter_the_data_do_not_see_is_open_up_to_the_end_of_its_range():
     """Data without friction (σ_fmax = 1 Pa, nothing at these strains): ε½ acts on nothing, so
     every value in its range fits them as well. The walk reaches ε½'s upper end, 10, which

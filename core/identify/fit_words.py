@@ -8,15 +8,19 @@ from __future__ import annotations
 import math
 
 from ..numbers import format_number
-from ..parameters import Parameter
+from ..parameters import BY_NAME, Parameter
 from ..registry import parameter_unit
 from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS
 
 
-def _unit_words(name: str, mode: str) -> str:
-    """" kg" after a value of ``name`` in ``mode``; nothing after a pure number."""
+def _value_words(name: str, value: float, mode: str) -> str:
+    """A value of parameter ``name`` (its fitting name, SI) in ``mode`` as people read it: a
+    material field in the unit of its field (``3.55 MPa``), an effect's parameter in its unit
+    (``0.52 kg``), a pure number alone."""
+    if name in BY_NAME:
+        return BY_NAME[name].unit.shown(value)
     unit = parameter_unit(name, mode)
-    return "" if unit == "–" else f" {unit}"
+    return format_number(value, 3) + ("" if unit == "–" else f" {unit}")
 
 
 def _pushed(spec: Parameter, x: float, interval, edge: str, span: float) -> bool:
@@ -42,15 +46,16 @@ def fit_warnings(problem, sol, intervals: dict, complete: bool) -> tuple[str, ..
         edge = "lower" if sol.x[i] - lo[i] <= 1e-6 * span else "upper" if hi[i] - sol.x[i] <= 1e-6 * span else None
         if edge and _pushed(spec, sol.x[i], intervals.get(name), edge, span):
             at_edge.add(name)
-            unit = _unit_words(name, problem.design.mode)
-            out.append(f"{name} ran to the {edge} end of its fitting range ({format_number(values[name], 3)}{unit}): "
+            shown = _value_words(name, values[name], problem.design.mode)
+            out.append(f"{name} ran to the {edge} end of its fitting range ({shown}): "
                        f"the model cannot follow these data there; check that the design's mode and "
                        f"geometry are those of the measurement")
     for name, (a, b) in intervals.items():
         if (a is None or b is None) and name not in at_edge:
-            unit = _unit_words(name, problem.design.mode)
+            mode = problem.design.mode
             which = ("any value in its fitting range" if a is None and b is None
-                     else f"any value up to {format_number(b, 3)}{unit}" if a is None else f"any value from {format_number(a, 3)}{unit} up")
+                     else f"any value up to {_value_words(name, b, mode)}" if a is None
+                     else f"any value from {_value_words(name, a, mode)} up")
             out.append(f"{name} is not determined by these data: {which} fits them as well "
                        f"({CONFIDENCE:.0%} profile); measure more amplitudes or frequencies to pin it down")
     if not complete:
