@@ -119,7 +119,7 @@ def outside_table(geometry: Geometry, mode: str) -> tuple[str, tuple[str, ...]]:
         return f"{format_number(unit.to_display(low), 3)}–{format_number(unit.to_display(high), 3)} {unit.display}"
 
     def value(name: str, v: float) -> str:
-        return f"{BY_NAME[name].symbol} = {format_number(mm[name].to_display(v), 3)} {mm[name].display}"
+        return f"{BY_NAME[name].symbol} = {mm[name].shown(v)}"
 
     parts, involved = [], []
     if not lo_r <= b / a <= hi_r:
