@@ -140,7 +140,6 @@ class DiagnosisView(pn.viewable.Viewer):
                 sizing_mode="stretch_width")),
             sizing_mode="stretch_width")
         self.report_tabs.param.watch(self._on_tab, "active")
-        self._later: dict | None = None  # the overlays whose LATER_GROUPS plots wait to be placed
         self._results = pn.Column(
             "### 3. What the diagnosis found",
             self.report,
@@ -174,7 +173,6 @@ class DiagnosisView(pn.viewable.Viewer):
         """The progress set for a diagnosis; False if one runs already."""
         if self.state.running:
             return False
-        self._later = None  # the last report's plots left to place: this diagnosis' report places its own
         self.state.param.update(running=True, message="", result=None, revealed=False, progress=0.0,
                                 progress_message="fitting the baseline")
         return True
@@ -233,7 +231,7 @@ class DiagnosisView(pn.viewable.Viewer):
         the browser handles the plots' messages, in order, before the data's, and lays out a page
         that holds them; README, "Speed")."""
         cancel(self._ahead)
-        self._ahead, self._later = None, None
+        self._ahead = None
         if self.state.data is not None and not self.state.running:
             try:
                 self._ahead = start_ahead(self.state.task())
@@ -241,24 +239,34 @@ class DiagnosisView(pn.viewable.Viewer):
                 pass  # the data cannot be diagnosed as they are: the click says why
         self._prepared += 1
         self._ready, self._overlays = set(), None
-        generation, doc = self._prepared, pn.state.curdoc
-        served = doc is not None and doc.session_context is not None
+        generation = self._prepared
 
-        def prepare(i: int):
-            s = self.state
-            if (generation != self._prepared or i >= len(PREPARE_STEPS) or s.running or s.result is not None
-                    or not page_open(doc)):
-                return  # newer data came, every plot is made, the click makes the rest, or the page closed
-            self._prepare(*PREPARE_STEPS[i])
-            if served:
-                doc.add_timeout_callback(lambda: prepare(i + 1), PREPARE_GAP_MS)
-            else:
-                prepare(i + 1)
+        def wanted() -> bool:  # until newer data, or a click (it makes the rest while its work runs: _diagnose)
+            return generation == self._prepared and not self.state.running and self.state.result is None
 
-        if served:
-            doc.add_next_tick_callback(lambda: prepare(0))
+        self._one_at_a_time([partial(self._prepare, *step) for step in PREPARE_STEPS], wanted)
+
+    def _one_at_a_time(self, steps: list, wanted, first_ms: int = 0):
+        """``steps`` run in turn while ``wanted()``: on a served page one every
+        :data:`PREPARE_GAP_MS` (the first ``first_ms`` from now, or on the event loop's next turn),
+        so that the loop reads the page's messages between two of them, and only while the page is
+        open; else all at once."""
+        doc = pn.state.curdoc
+        if doc is None or doc.session_context is None:
+            for step in steps:
+                if wanted():
+                    step()
+            return
+
+        def run(i: int):
+            if i < len(steps) and wanted() and page_open(doc):
+                steps[i]()
+                doc.add_timeout_callback(partial(run, i + 1), PREPARE_GAP_MS)
+
+        if first_ms:
+            doc.add_timeout_callback(partial(run, 0), first_ms)
         else:
-            prepare(0)
+            doc.add_next_tick_callback(partial(run, 0))
 
     def _prepare(self, name: str, index: int):
         """The plot ``index`` of the group ``name`` of the report's plots made ready for the loaded
@@ -289,44 +297,27 @@ class DiagnosisView(pn.viewable.Viewer):
         :data:`LATER_GROUPS` not yet in the page are put there after this change has gone to the
         browser, :data:`LATER_AFTER_MS` after it or when their tab is opened, one every
         :data:`PREPARE_GAP_MS` (:meth:`_place_later`): the report's message and its first frame
-        wait for none of them."""
-        doc = pn.state.curdoc
-        served = doc is not None and doc.session_context is not None
+        wait for none of them. Unserved, all at once."""
         for name in PLOT_GROUPS:
-            if served and name in LATER_GROUPS:
-                self._plot(name, overlays, self._placed(name))  # the numbers into those in the page
-            else:
-                self._plot(name, overlays)
-        later = served and any(self._placed(name) < PLOT_COUNTS[name] for name in LATER_GROUPS)
-        self._later = overlays if later else None
-        if later:
-            if self.report_tabs.active == 0:
-                doc.add_timeout_callback(partial(self._place_later, doc, overlays), LATER_AFTER_MS)
-            else:
-                doc.add_next_tick_callback(partial(self._place_later, doc, overlays))
+            self._plot(name, overlays, self._placed(name) if name in LATER_GROUPS else None)
+        self._place_later(LATER_AFTER_MS if self.report_tabs.active == 0 else 0)
 
     def _placed(self, name: str) -> int:
         """How many plots of group ``name`` are in the page."""
         return sum(1 for slot in self._slots[name] if slot.objects)
 
-    def _place_later(self, doc, overlays: dict):
-        """One plot of :data:`LATER_GROUPS` not yet in the page put there, then the next one
-        :data:`PREPARE_GAP_MS` later, while ``overlays`` is still the report's to place (newer
-        data or a newer report take over) and the page is open."""
-        if self._later is not overlays or not page_open(doc):
-            return
-        name = next((n for n in LATER_GROUPS if self._placed(n) < PLOT_COUNTS[n]), None)
-        if name is None:
-            self._later = None
-            return
-        update_or_keep("DiagnosisView placed no plot", lambda: self._plot(name, overlays, self._placed(name) + 1))
-        doc.add_timeout_callback(partial(self._place_later, doc, overlays), PREPARE_GAP_MS)
+    def _place_later(self, first_ms: int = 0):
+        """The plots of :data:`LATER_GROUPS` not yet in the page put there one at a time
+        (:meth:`_one_at_a_time`), while a report is shown."""
+        steps = [partial(update_or_keep, "DiagnosisView placed no plot", partial(self._place, name, count))
+                 for name in LATER_GROUPS for count in range(self._placed(name) + 1, PLOT_COUNTS[name] + 1)]
+        if steps:
+            self._one_at_a_time(steps, lambda: self.state.result is not None, first_ms)
 
     def _on_tab(self, event):
-        """The maps' tab opened while its plots wait to be placed: placed from now on."""
-        doc = pn.state.curdoc
-        if event.new != 0 and self._later is not None and doc is not None and doc.session_context is not None:
-            doc.add_next_tick_callback(partial(self._place_later, doc, self._later))
+        """The maps' tab opened: those of its plots not yet in the page put there from now on."""
+        if event.new != 0:
+            self._place_later()
 
     def _plot(self, name: str, overlays: dict, count: int | None = None):
         """The group ``name`` of the report's plots showing ``overlays[name]``, its first ``count``
@@ -337,7 +328,11 @@ class DiagnosisView(pn.viewable.Viewer):
         elif self._shown.get(name) is not overlays:
             live.show(overlays[name])
         self._shown[name] = overlays
-        for slot, pane in zip(self._slots[name][:count], live.panes):
+        self._place(name, count)
+
+    def _place(self, name: str, count: int | None = None):
+        """The first ``count`` plots (all if None) of group ``name`` in their places on the page."""
+        for slot, pane in zip(self._slots[name][:count], self.live[name].panes):
             if not slot.objects:
                 slot.objects = [pane]
 
