@@ -7,8 +7,7 @@ from __future__ import annotations
 
 import math
 
-from ..numbers import format_number
-from ..parameters import BY_NAME, Parameter
+from ..parameters import BY_NAME, Parameter, Unit
 from ..registry import parameter_unit
 from .uncertainty import CONFIDENCE, SIDE_EVALUATIONS
 
@@ -19,8 +18,8 @@ def _value_words(name: str, value: float, mode: str) -> str:
     (``0.52 kg``), a pure number alone."""
     if name in BY_NAME:
         return BY_NAME[name].unit.shown(value)
-    unit = parameter_unit(name, mode)
-    return format_number(value, 3) + ("" if unit == "–" else f" {unit}")
+    si = parameter_unit(name, mode)
+    return Unit(si, si).shown(value)
 
 
 def _pushed(spec: Parameter, x: float, interval, edge: str, span: float) -> bool:
