@@ -125,6 +125,15 @@ def test_a_fit_the_data_cannot_determine_says_so_in_the_app(app):
     row = next(line for line in text.splitlines() if line.startswith("| µ"))
     assert row.split("|")[3].strip() == "–" and "not bounded" in row and "**not determined**" in row
     assert "⚠ shear_modulus is not determined by these data" in text
+    # σ_fmax has a bounded profile but no linearised error: a dash and the reason, never a 0
+    # standard error nor an inf correlation
+    row = next(line for line in text.splitlines() if line.startswith("| σ_fmax ("))
+    assert row.split("|")[3].strip() == "–"
+    table = text.partition("**Correlation between parameters**")[2]
+    assert "inf" not in table and "nan" not in table
+    fc = next(line for line in table.splitlines() if line.startswith("| m "))
+    assert [cell.strip() for cell in fc.split("|")[1:-1]].count("–") == 3
+    assert "no linearised standard error or correlation for µ, σ_fmax, ε½" in table
 
 
 def test_fit_without_data_says_so(app):

@@ -70,6 +70,39 @@ def test_a_single_amplitude_sweep_says_which_parameters_it_cannot_determine():
     assert {"fractional_coefficient", "fractional_order"}.isdisjoint(result.undetermined)
 
 
+def test_a_direction_the_data_do_not_fix_has_no_linearised_error_the_others_keep_theirs():
+    """The sweep at one amplitude leaves µ, σ_fmax and ε½ one common direction along which the
+    misfit is flat: their linearised standard errors are not 0 (as inverting JᵀJ gave, whose
+    condition is beyond double precision) but infinite, null in the file, and their correlations
+    not defined (null, never ±inf). m and α, apart from that direction, keep theirs: an estimable
+    parameter's variance does not depend on how the undetermined direction is pinned, so they
+    must equal those of the same optimum with ε½ held at its fitted value (one parameter fewer,
+    the residual variance's degrees of freedom scaled accordingly)."""
+    design = read_design(EXAMPLES / "paper_b_guess.json")
+    data = read_stiffness(EXAMPLES / "paper_b_sweep_0.1mm.csv")
+    result = fit_global(design, data, intervals=False)
+    flat = ("shear_modulus", "friction_stress_max", "friction_strain_half")
+    fixed = ("fractional_coefficient", "fractional_order")
+    for name in flat:
+        assert math.isinf(result.standard_errors[name]), name
+    report = json.loads(result.to_json())["fit"]
+    for a in result.correlation:
+        for b in result.correlation:
+            value = report["correlation"][a][b]
+            assert (value is None) == (a in flat or b in flat), (a, b)
+    assert all(report["standard_errors"][name] is None for name in flat)
+
+    pinned = fit_global(result.design, data, free=("shear_modulus", *fixed, "friction_stress_max"),
+                        starts=1, intervals=False)
+    assert pinned.cost == pytest.approx(result.cost, rel=1e-6)  # the same optimum
+    n = 2 * len(data)
+    scale = math.sqrt((n - 4) / (n - 5))
+    for name in fixed:
+        assert math.isfinite(result.standard_errors[name])
+        assert result.standard_errors[name] == pytest.approx(pinned.standard_errors[name] * scale, rel=1e-6), name
+    assert result.correlation[fixed[0]][fixed[1]] == pytest.approx(pinned.correlation[fixed[0]][fixed[1]], abs=1e-8)
+
+
 def test_five_amplitudes_determine_everything():
     design = read_design(EXAMPLES / "paper_b_guess.json")
     result = fit_global(design, read_stiffness(EXAMPLES / "paper_b_stiffness.csv"))

@@ -47,7 +47,7 @@ def data_overlays(groups: list, dims: dict) -> dict:
     fitted = bool(groups) and "fitted" in groups[0]
     models = ((("start", "start", {"line_dash": "dashed", "line_width": 1.5}),
                ("fitted", "fitted", {"line_width": 2})) if fitted else (("start", "model", {"line_width": 2}),))
-    return amplitude_curves(groups, dims, models, "measured (dots) and model (lines) at each amplitude",
+    return amplitude_curves(groups, dims, models, "data (dots), model (lines)",
                             "bushing-measured")
 
 

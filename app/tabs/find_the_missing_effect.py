@@ -376,7 +376,7 @@ class DiagnosisView(pn.viewable.Viewer):
             unit = effect_units(step.effect, r.baseline.model.design.mode)
             params = ", ".join(f"{k} = {format_value(v, unit.get(k, ''))}" + (f" ± {format_value(step.standard_errors[k], unit.get(k, ''), 'error')}"
                                                    if np.isfinite(step.standard_errors.get(k, np.nan)) else
-                                                   " (not determined)" if k in step.undetermined else "")
+                                                   " (not determined)" if k in step.undetermined or np.isinf(step.standard_errors.get(k, np.nan)) else "")
                                for k, v in step.parameters.items()) or "no parameters"
             partner = step.extra.get("found_with")
             together = f" (found together with {effect_title(partner)})" if partner else ""

@@ -258,7 +258,13 @@ class MeasuredView(PlotView):
         corr = ["| | " + " | ".join(BY_NAME[p].symbol for p in MATERIAL) + " |",
                 "|---" * (len(MATERIAL) + 1) + "|"]
         for a in MATERIAL:
-            corr.append(f"| {BY_NAME[a].symbol} | " + " | ".join(f"{r.correlation[a][b]:+.2f}" for b in MATERIAL) + " |")
+            corr.append(f"| {BY_NAME[a].symbol} | " + " | ".join(
+                f"{r.correlation[a][b]:+.2f}" if np.isfinite(r.correlation[a][b]) else "–" for b in MATERIAL) + " |")
+        flat = [BY_NAME[p].symbol for p in MATERIAL if not np.isfinite(r.standard_errors[p])]
+        if flat:  # the linearised errors cannot be formed along a direction the data do not fix
+            corr.append(f"\n– : no linearised standard error or correlation for {', '.join(flat)}: the data fix no "
+                        "combination of them to first order (the misfit is flat along one); the profile "
+                        "intervals above say what the data bound.")
         warnings = "".join(f"\n\n⚠ {w}" for w in r.warnings)
         by_mode = ("\n\nGap per mode: " + ", ".join(f"{m} **{g:.4f}**" for m, g in r.gap_by_mode.items())
                    if r.gap_by_mode else "")

@@ -15,7 +15,7 @@ from tests.ui.bokeh_page import open_explorer, plots, settle, wait_plot, wait_pl
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 TAB = "Measured data and fit"
 FIT = "Fit the five material parameters"
-DATA_TITLE = "|K|: measured (dots) and model (lines) at each amplitude"
+DATA_TITLE = "|K|: data (dots), model (lines)"
 RESIDUAL_TITLE = "|K| residual against frequency"
 
 # every glyph of a figure: its kind, colour (line or fill) and data

@@ -3,12 +3,16 @@ header is on screen and opens its tab, every tab's content takes the width, no t
 window or by a box that clips it), every figure's title fits its figure, and the sidebar scrolls
 rather than cuts. Each tab is also shot, at both sizes, into the test's folder."""
 
+from pathlib import Path
+
 import pytest
 
 from tests.ui.bokeh_page import open_explorer, settle
+from tests.ui.test_waiting_browser import upload_150_points
 from tools.screenshots import DRAWN_JS, slug
 
 SIZES = ((1280, 720), (1600, 1000))
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 # the tab bar's headers: text and box (page pixels)
 HEADERS_JS = """() => {
@@ -48,7 +52,9 @@ CLIPPED_TEXT_JS = """() => {
       for (let a = n.parentElement; a instanceof Element && !cut; a = parentOf(a)) {
         if (getComputedStyle(a).overflowX === 'visible') continue;
         const b = a.getBoundingClientRect();
-        if (b.width === 0) { hidden = true; break; }  // inside something not shown
+        // inside something not shown, or shown to screen readers only (a box of a pixel, as
+        // FilePond's file names and button labels)
+        if (b.width <= 1 || b.height <= 1) { hidden = true; break; }
         if (r.left < b.left - 1 || r.right > b.right + 1) cut = `${a.tagName.toLowerCase()}.${a.className}`;
       }
       if (cut && !hidden) out.push([n.textContent.trim().slice(0, 80), Math.round(r.left), Math.round(r.right), cut]);
@@ -126,3 +132,40 @@ def test_every_tab_reachable_and_nothing_cut(page, explorer_url, console_errors,
     if sidebar["scroll"] > sidebar["client"]:  # more than it shows: it scrolls, within the window
         assert sidebar["overflow"] in ("auto", "scroll"), sidebar
         assert sidebar["bottom"] <= height + 1, sidebar
+
+
+def cut(page) -> list:
+    """What the window or a box cuts on the page as it is: texts, then figure titles."""
+    return ([("text cut", c) for c in page.evaluate(CLIPPED_TEXT_JS)]
+            + [("figure title cut", c) for c in page.evaluate(TITLES_CUT_JS)])
+
+
+@pytest.mark.parametrize("size", SIZES, ids=[f"{w}x{h}" for w, h in SIZES])
+def test_nothing_cut_with_data_a_fit_and_a_report(page, explorer_url, console_errors, tmp_path, size):
+    """The views that only data fill: the measured data over the fitted and the starting
+    model, the fit's tables, the diagnosis' report and its maps (their plot titles were cut at
+    1280×720: "|K|: measured (dots) and model (lines) at each amplitude" in 329 pixels)."""
+    width, height = size
+    page.set_viewport_size({"width": width, "height": height})
+    open_explorer(page, explorer_url)
+    page.get_by_text("Measured data and fit", exact=True).click()
+    page.locator("#main input[type=file]").first.set_input_files(str(EXAMPLES / "paper_b_stiffness.csv"))
+    page.get_by_role("button", name="Fit the five material parameters").click()
+    page.get_by_text("Correlation between parameters").wait_for(timeout=120_000)
+    page.wait_for_function(DRAWN_JS, timeout=60_000)
+    settle(page)
+    page.screenshot(path=str(tmp_path / f"{width}x{height}-fit.png"))
+    problems = [("fit", *c) for c in cut(page)]
+
+    upload_150_points(page, tmp_path)
+    page.get_by_role("button", name="Diagnose").click()
+    page.get_by_text("What is left is noise", exact=True).wait_for(timeout=120_000)
+    page.wait_for_function(DRAWN_JS, timeout=60_000)
+    settle(page)
+    page.screenshot(path=str(tmp_path / f"{width}x{height}-report.png"))
+    problems += [("report", *c) for c in cut(page)]
+    page.get_by_text("Where they disagree: misfit maps", exact=True).click()
+    page.wait_for_function(DRAWN_JS, timeout=60_000)
+    settle(page)
+    problems += [("maps", *c) for c in cut(page)]
+    assert problems == [], "\n".join(map(str, problems))

@@ -187,7 +187,9 @@ def summary(diagnosis: Diagnosis) -> str:
         lines[0] += f" (noise alone gives about {diagnosis.noise_gap:.4g})"
     lines.append(f"  where it disagrees: {diagnosis.where_baseline}")
     for n, s in enumerate(diagnosis.steps, 1):
-        params = ", ".join(f"{k} = {v:.4g}" + (f" ± {s.standard_errors[k]:.2g}" if math.isfinite(s.standard_errors.get(k, math.nan)) else "")
+        params = ", ".join(f"{k} = {v:.4g}" + (f" ± {s.standard_errors[k]:.2g}" if math.isfinite(s.standard_errors.get(k, math.nan))
+                                                else " (not determined)" if k in s.undetermined
+                                                or math.isinf(s.standard_errors.get(k, math.nan)) else "")
                            for k, v in s.parameters.items()) or "no parameters"
         support = s.support_words()
         lines.append(f"step {n}: add {s.effect} ({s.title}){' ' + support if s.mode else ''}: {params}; "
