@@ -281,6 +281,11 @@ def inertia_correction(stiffness, frequency_hz, mass: float):
     return stiffness - omega**2 * mass
 
 
+# |Im ka| beyond which the standing waves' cross product is taken from scaled Hankel functions:
+# J_n and Y_n's products then cancel to e^−4 of their size at most on the other side
+DECAYING = 2.0
+
+
 def wave_stiffness(mode: str, inner_radius, outer_radius, length, modulus, frequency_hz, density):
     """Stiffness with standing shear waves in the rubber (docs/model.md, ``wave_effects``).
 
@@ -305,19 +310,31 @@ def wave_stiffness(mode: str, inner_radius, outer_radius, length, modulus, frequ
 
 
 def _standing_waves(mode: str, a, b, L, mu, k):
-    """:func:`wave_stiffness`'s Bessel solution at wavenumber ``k`` (complex, nonzero)."""
-    ka, kb = k * a, k * b
-    if mode == "axial":
-        # A J0(ka) + B Y0(ka) = 0, A J0(kb) + B Y0(kb) = 1 (unit drive)
-        j_a, y_a, j_b, y_b = special.jv(0, ka), special.yv(0, ka), special.jv(0, kb), special.yv(0, kb)
-        det = j_a * y_b - j_b * y_a
-        A, B = -y_a / det, j_a / det
-        dw = -k * (A * special.jv(1, ka) + B * special.yv(1, ka))
-        return 2.0 * np.pi * a * L * mu * dw
-    # torsion: v(b) = b per unit angle
-    j_a, y_a, j_b, y_b = special.jv(1, ka), special.yv(1, ka), special.jv(1, kb), special.yv(1, kb)
-    det = j_a * y_b - j_b * y_a
-    A, B = -b * y_a / det, b * j_a / det
-    # d/dr J1(kr) = k J0(kr) − J1(kr)/r, likewise Y1
-    dv = A * (k * special.jv(0, ka) - j_a / a) + B * (k * special.yv(0, ka) - y_a / a)
-    return 2.0 * np.pi * a * a * L * mu * dv
+    """:func:`wave_stiffness`'s Bessel solution at wavenumber ``k`` (complex, nonzero).
+
+    With u = A Z(kr) + B W(kr) (order n = 0 axially, 1 in torsion) held at r = a and driven at
+    r = b, the Wronskian J_n'(z) Y_n(z) − J_n(z) Y_n'(z) = −2/(π z) makes the inner face's traction
+    a ratio of one cross product: K = 4 L µ_eq / D_0 axially and K = 4 a b L µ_eq / D_1 in
+    torsion, D_n = J_n(ka) Y_n(kb) − J_n(kb) Y_n(ka). Where the waves decay across the rubber
+    (|Im ka| above :data:`DECAYING`) J and Y grow like e^|Im z| and their products cancel to
+    e^−2|Im ka| of their size, all of it past |Im ka| ≈ 18 (at 1 MHz: NaN in torsion, a wrong sign
+    axially); D_n is then taken from the exponentially scaled Hankel functions, the growing
+    exponential factored out: D_n = (H²_n(ka) H¹_n(kb) − H¹_n(ka) H²_n(kb)) / 2i."""
+    n = 0 if mode == "axial" else 1
+    k = np.asarray(k, dtype=complex)
+    ka, kb = np.broadcast_arrays(k * a, k * b)  # a geometry of samples: a row each
+    inverse = np.empty(ka.shape, dtype=complex)  # 1 / D_n
+    decaying = np.abs(ka.imag) > DECAYING
+    near = ~decaying
+    if near.any():
+        za, zb = ka[near], kb[near]
+        inverse[near] = 1.0 / (special.jv(n, za) * special.yv(n, zb) - special.jv(n, zb) * special.yv(n, za))
+    if decaying.any():
+        za, zb = ka[decaying], kb[decaying]
+        d = zb - za  # H¹(z) = h¹(z) e^{iz}, H²(z) = h²(z) e^{−iz}: D_n 2i = h²_a h¹_b e^{id} − h¹_a h²_b e^{−id}
+        up = d.imag < 0  # e^{id} the larger
+        phase = np.exp(np.where(up, -1j * d, 1j * d))  # the smaller of e^{±id}, |phase| ≤ 1
+        ab, ba = special.hankel2e(n, za) * special.hankel1e(n, zb), special.hankel1e(n, za) * special.hankel2e(n, zb)
+        inverse[decaying] = 2j * phase / np.where(up, ab - ba * phase**2, ab * phase**2 - ba)
+    factor = 4.0 * L if mode == "axial" else 4.0 * a * b * L
+    return factor * mu * inverse

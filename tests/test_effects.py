@@ -160,3 +160,51 @@ def test_standing_waves_without_density_are_the_static_closed_form(mode):
         k = wave_stiffness(mode, a, b, length, mu[0], 10.0, rho)
         static = long_shape_factor(a, b, length, mode) * mu[0]
         assert abs(k / static - 1) < max(kb**2, 1e-9)
+
+
+def _wave_stiffness_digits(mode, a, b, length, mu, f, rho):
+    """The standing waves' stiffness from their defining formulas (u = A J_n(kr) + B Y_n(kr),
+    A and B from the two boundary conditions, K from the traction at r = a) in mpmath at
+    40 digits more than J and Y's growth e^|Im kb| costs: a route that shares neither the
+    Wronskian nor the Hankel functions of :func:`core.effects.wave_stiffness`."""
+    mp = pytest.importorskip("mpmath")
+    with mp.workdps(40 + int(abs((2 * np.pi * f * np.sqrt(rho / complex(mu)) * b).imag))):
+        n = 0 if mode == "axial" else 1
+        m = mp.mpc(complex(mu).real, complex(mu).imag)
+        a, b, length = mp.mpf(a), mp.mpf(b), mp.mpf(length)
+        k = 2 * mp.pi * mp.mpf(f) * mp.sqrt(mp.mpf(rho) / m)
+        j, y = mp.besselj, mp.bessely
+        det = j(n, k * a) * y(n, k * b) - j(n, k * b) * y(n, k * a)
+        end = 1 if n == 0 else b  # w(b) = 1, or v(b) = b φ with φ = 1
+        big_a, big_b = -end * y(n, k * a) / det, end * j(n, k * a) / det
+        if n == 0:
+            return complex(2 * mp.pi * a * length * m * -k * (big_a * j(1, k * a) + big_b * y(1, k * a)))
+        dv = big_a * (k * j(0, k * a) - j(1, k * a) / a) + big_b * (k * y(0, k * a) - y(1, k * a) / a)
+        return complex(2 * mp.pi * a * a * length * m * dv)
+
+
+@pytest.mark.parametrize("mode", ["axial", "torsion"])
+@pytest.mark.parametrize("f", [1e-3, 10.0, 3e3, 2.2e4, 1e5, 3e5])
+def test_standing_waves_hold_their_digits_where_the_waves_decay(mode, f):
+    """Up to 300 kHz (|Im ka| from 0 to 35, on either side of the switch to the Hankel functions
+    at |Im ka| = 2), on the design's geometry and a thicker one: the stiffness to 1e-10 of the
+    high-precision route's, finite. Inverting the two boundary conditions in double precision
+    (the formulas themselves) lost 3.7e-7 of the stiffness at 100 kHz, and its sign axially and
+    everything in torsion (NaN) at 1 MHz (the next test)."""
+    design = PAPER_B if mode == "axial" else TABLE_1
+    g = design.geometry
+    for a, b in ((g.inner_radius, g.outer_radius), (0.01, 0.03)):
+        mu = complex(equivalent_modulus(design.material, f, 1e-4))
+        got = complex(wave_stiffness(mode, a, b, g.length, mu, f, 1100.0))
+        assert np.isfinite(got)
+        assert got == pytest.approx(_wave_stiffness_digits(mode, a, b, g.length, mu, f, 1100.0), rel=1e-10)
+
+
+def test_standing_waves_at_a_megahertz_through_stiffness():
+    """The public route (``stiffness``) with wave effects at 1 MHz: finite numbers, the
+    transmitted stiffness far below the quasi-static one (the waves die out across the rubber)."""
+    for design in (PAPER_B, TABLE_1):
+        waves = design.replace(effects={"wave_effects": {"density": 1100.0}})
+        r = stiffness(waves, [10.0, 1e6], 1e-4)
+        assert np.all(np.isfinite(r.stiffness)) and np.all(np.isfinite(r.loss_factor))
+        assert r.magnitude[0, 1] < 1e-6 * r.magnitude[0, 0]
