@@ -305,8 +305,17 @@ def wave_stiffness(mode: str, inner_radius, outer_radius, length, modulus, frequ
     if np.any(static):
         with np.errstate(all="ignore"):
             waves = _standing_waves(mode, a, b, L, mu, np.where(static, 1.0 / b, k))
-        return np.where(static, long_shape_factor(a, b, L, mode) * mu, waves)
-    return _standing_waves(mode, a, b, L, mu, k)
+        waves = np.where(static, long_shape_factor(a, b, L, mode) * mu, waves)
+    else:
+        waves = _standing_waves(mode, a, b, L, mu, k)
+    lost = (waves == 0) & (mu != 0)  # below the least double: no loss factor, no number
+    if np.any(lost):
+        where = np.argwhere(lost)[0]
+        f = np.broadcast_to(np.asarray(frequency_hz, dtype=float), lost.shape)[tuple(where)]
+        raise ValueError(f"wave_effects: at {f:.6g} Hz the shear waves die out across the rubber: the stiffness "
+                         "they pass to the inner sleeve is below the smallest number the computation holds; "
+                         "lower the frequency, or check the density, the moduli and the radii")
+    return waves
 
 
 def _standing_waves(mode: str, a, b, L, mu, k):

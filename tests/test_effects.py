@@ -208,3 +208,15 @@ def test_standing_waves_at_a_megahertz_through_stiffness():
         r = stiffness(waves, [10.0, 1e6], 1e-4)
         assert np.all(np.isfinite(r.stiffness)) and np.all(np.isfinite(r.loss_factor))
         assert r.magnitude[0, 1] < 1e-6 * r.magnitude[0, 0]
+
+
+def test_waves_that_die_out_across_the_rubber_are_refused_with_their_frequency():
+    """A soft, wide bushing (µ 1.9 kPa, b 0.54 m) at 49 kHz: the stiffness the waves pass to the
+    inner sleeve is below the least double, so it came out 0 and its loss factor 0/0 (NaN); the
+    design file allows it, so the model says why it gives no number, naming the frequency."""
+    design = PAPER_B.replace(inner_radius=0.0422, outer_radius=0.544, length=0.0984, shear_modulus=1927.5,
+                             fractional_coefficient=2009.8, fractional_order=0.44, friction_stress_max=9029.5,
+                             friction_strain_half=0.000426, effects={"wave_effects": {"density": 462.47}})
+    assert np.all(np.isfinite(stiffness(design, [10.0, 1e3], 4.62e-3).loss_factor))
+    with pytest.raises(ValueError, match="at 49000 Hz the shear waves die out across the rubber"):
+        stiffness(design, [10.0, 4.9e4], 4.62e-3)
