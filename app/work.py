@@ -43,6 +43,7 @@ import logging
 import multiprocessing
 import os
 import threading
+import time
 from collections.abc import Callable, Iterable
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
@@ -53,6 +54,7 @@ import numpy as np
 
 log = logging.getLogger("bushing.app")
 
+WATCH_S = 1.0  # s between a worker's two looks at its server (ended when it is gone)
 PROGRESS_POLL_S = 0.15  # s between two progress updates on the page
 # s before each step done on the event loop while the work runs (in_thread's ``meanwhile``): the
 # loop writes the page's messages meanwhile (the progress set at a click can wait for the server's
@@ -110,7 +112,7 @@ def use_processes(count: int | None = None) -> None:
         context.set_forkserver_preload(PRELOAD)
         _queue, _size, _cancelled = context.Queue(), count or workers(), context.RawArray("q", CANCEL_SLOTS)
         _pool = ProcessPoolExecutor(max_workers=_size, mp_context=context,
-                                    initializer=_start_worker, initargs=(_queue, _cancelled))
+                                    initializer=_start_worker, initargs=(_queue, _cancelled, os.getpid()))
         threading.Thread(target=_relay, args=(_queue,), name="work-progress", daemon=True).start()
         for _ in range(_size):
             _pool.submit(int)
@@ -127,9 +129,36 @@ def stop_processes() -> None:
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _start_worker(queue, cancelled) -> None:
+def _start_worker(queue, cancelled, server: int) -> None:
     global _worker_queue, _worker_cancelled
     _worker_queue, _worker_cancelled = queue, cancelled
+    threading.Thread(target=_watch_server, args=(server,), name="watch-server", daemon=True).start()
+
+
+def _watch_server(server: int) -> None:
+    """In a worker: end the process once the server that started it is gone. A server killed
+    outright (SIGKILL, the kernel's out-of-memory killer) stops nothing: its worker held the
+    pipes by which the forkserver and the resource tracker would see their parent gone, so all
+    three ran on, orphaned; the worker gone, they see it and end too."""
+    while True:
+        time.sleep(WATCH_S)
+        if _gone(server):
+            os._exit(0)
+
+
+def _gone(pid: int) -> bool:
+    """Whether process ``pid`` has ended (or is a zombie that nothing has reaped yet)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except OSError:
+        return False  # it exists (owned by another user: not ours to signal, but alive)
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii", errors="replace") as stat:
+            return stat.read().rsplit(")", 1)[1].split()[0] == "Z"
+    except (OSError, IndexError):
+        return False  # no /proc: the signal's answer stands
 
 
 def _relay(queue) -> None:

@@ -3,6 +3,7 @@
 import csv
 import io
 import json
+import os
 import re
 import shutil
 import subprocess
@@ -285,6 +286,40 @@ def _running(pid: int) -> bool:
         return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
     except OSError:
         return False
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads the process table from /proc")
+def test_a_killed_server_leaves_no_worker_process_behind():
+    """SIGKILL (the kernel's out-of-memory killer, a forced stop) gives the server no chance to
+    stop its worker processes: the worker notices its server gone and ends, and with it the
+    forkserver and the resource tracker, which it held open (all three ran on, orphaned)."""
+    import signal
+    import time
+
+    proc = subprocess.Popen([sys.executable, "-m", "cli.main", "serve", "--port", "0"],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    workers: set[int] = set()
+    try:
+        found = re.fullmatch(r"Bushing Explorer: http://localhost:(\d+)/", proc.stdout.readline().strip())
+        assert found, "no URL printed"
+        assert b"Bushing Explorer" in fetch(f"http://localhost:{found.group(1)}/")
+        workers = _descendants(proc.pid)
+        assert len(workers) >= 3  # the resource tracker, the forkserver and its worker
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(60)
+        for _ in range(600):  # bounded by count: at most about 60 s
+            if not any(_running(p) for p in workers):
+                break
+            time.sleep(0.1)
+        assert not [p for p in workers if _running(p)]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(10)
+        proc.stdout.close()
+        for p in workers:  # the test's own failure leaves nothing running either
+            if _running(p):
+                os.kill(p, signal.SIGKILL)
 
 
 @pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads the process table from /proc")
