@@ -288,11 +288,10 @@ def _running(pid: int) -> bool:
         return False
 
 
-@pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads the process table from /proc")
-def test_a_killed_server_leaves_no_worker_process_behind():
-    """SIGKILL (the kernel's out-of-memory killer, a forced stop) gives the server no chance to
-    stop its worker processes: the worker notices its server gone and ends, and with it the
-    forkserver and the resource tracker, which it held open (all three ran on, orphaned)."""
+def _stopped_with_its_workers(how: int) -> int | None:
+    """Start `bushing serve`, send it the signal ``how``, and wait (bounded by count, about 60 s
+    at most) for every process it had started to end: the server's exit status. Asserts that
+    none is left; kills whatever is, so that a failure leaves nothing running."""
     import signal
     import time
 
@@ -305,21 +304,32 @@ def test_a_killed_server_leaves_no_worker_process_behind():
         assert b"Bushing Explorer" in fetch(f"http://localhost:{found.group(1)}/")
         workers = _descendants(proc.pid)
         assert len(workers) >= 3  # the resource tracker, the forkserver and its worker
-        proc.send_signal(signal.SIGKILL)
-        proc.wait(60)
-        for _ in range(600):  # bounded by count: at most about 60 s
+        proc.send_signal(how)
+        status = proc.wait(60)
+        for _ in range(600):
             if not any(_running(p) for p in workers):
                 break
             time.sleep(0.1)
         assert not [p for p in workers if _running(p)]
+        return status
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait(10)
         proc.stdout.close()
-        for p in workers:  # the test's own failure leaves nothing running either
+        for p in workers:
             if _running(p):
                 os.kill(p, signal.SIGKILL)
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads the process table from /proc")
+def test_a_killed_server_leaves_no_worker_process_behind():
+    """SIGKILL (the kernel's out-of-memory killer, a forced stop) gives the server no chance to
+    stop its worker processes: the worker notices its server gone and ends, and with it the
+    forkserver and the resource tracker, which it held open (all three ran on, orphaned)."""
+    import signal
+
+    assert _stopped_with_its_workers(signal.SIGKILL) == -signal.SIGKILL
 
 
 @pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads the process table from /proc")
@@ -328,25 +338,5 @@ def test_serve_stops_with_its_worker_processes_on_sigterm():
     its worker processes (the diagnosis' forkserver, worker and resource tracker) end with it:
     SIGTERM used to kill the server alone and leave them running, orphaned, at every stop."""
     import signal
-    import time
 
-    proc = subprocess.Popen([sys.executable, "-m", "cli.main", "serve", "--port", "0"],
-                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    try:
-        found = re.fullmatch(r"Bushing Explorer: http://localhost:(\d+)/", proc.stdout.readline().strip())
-        assert found, "no URL printed"
-        assert b"Bushing Explorer" in fetch(f"http://localhost:{found.group(1)}/")
-        workers = _descendants(proc.pid)
-        assert workers  # the diagnosis' worker processes, started with the server
-        proc.send_signal(signal.SIGTERM)
-        assert proc.wait(60) == 0
-        for _ in range(600):  # bounded by count: at most about 60 s
-            if not any(_running(p) for p in workers):
-                break
-            time.sleep(0.1)
-        assert not [p for p in workers if _running(p)]
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait(10)
-        proc.stdout.close()
+    assert _stopped_with_its_workers(signal.SIGTERM) == 0
