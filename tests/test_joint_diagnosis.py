@@ -1,6 +1,8 @@
 """The discrepancy workflow on data of several modes: one material for every mode, each step's
 support mode by mode, an apparent mass found on the rig that has it, and modes that disagree."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -99,6 +101,8 @@ def test_a_fixture_mass_on_the_axial_rig_is_found_there(design_mode):
     assert step.mode == "axial" and step.report()["mode"] == "axial"
     assert step.parameters["mass"] == pytest.approx(0.4, abs=3 * step.standard_errors["mass"])
     assert "on the axial rig only" in summary(result)
+    # the mass in the unit of the rig it was found on, whatever the design's mode (issue #27, item 5)
+    assert re.search(r"mass = [0-9.]+ kg ± [0-9.]+ kg;", summary(result)), summary(result)
     final = result.final.design
     assert final.in_mode("axial").effect_parameters["inertia"]["mass"] == pytest.approx(step.parameters["mass"])
     assert final.in_mode("torsion").effect_parameters == {}

@@ -46,12 +46,6 @@ def _effect_card(eid: str) -> str:
     return f"**{e.title}** (`{eid}`). {e.physics} *Signature in data:* {e.signature}"
 
 
-def effect_units(effect: str, mode: str) -> dict[str, str]:
-    """The units of ``effect``'s fitted parameters in ``mode`` (by their names in a report, plain
-    or ``effect.name``), from the one table (:class:`core.parameters.Parameter`)."""
-    return {key: p.unit_in(mode) for p in EFFECTS[effect].parameters for key in (p.name, f"{effect}.{p.name}")}
-
-
 PLOT_GROUPS = ("gap", "curves", "maps")  # the report's plots, in the order the page shows them
 PLOT_COLUMNS = {"gap": 1, "curves": 2, "maps": 2}
 PLOT_COUNTS = {"gap": 1, "curves": 2, "maps": 4}  # plots per group
@@ -373,11 +367,7 @@ class DiagnosisView(pn.viewable.Viewer):
             f"*Where it disagrees:* {r.where_baseline}",
         ]
         for n, step in enumerate(r.steps, 1):
-            unit = effect_units(step.effect, r.baseline.model.design.mode)
-            params = ", ".join(f"{k} = {format_value(v, unit.get(k, ''))}" + (f" ± {format_value(step.standard_errors[k], unit.get(k, ''), 'error')}"
-                                                   if np.isfinite(step.standard_errors.get(k, np.nan)) else
-                                                   " (not determined)" if k in step.undetermined or np.isinf(step.standard_errors.get(k, np.nan)) else "")
-                               for k, v in step.parameters.items()) or "no parameters"
+            params = step.parameter_words(r.baseline.model.design.mode)
             partner = step.extra.get("found_with")
             together = f" (found together with {effect_title(partner)})" if partner else ""
             support = step.support_words()

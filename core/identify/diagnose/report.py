@@ -10,6 +10,8 @@ import numpy as np
 
 from ...data import MeasuredStiffness
 from ...design import Design
+from ...effects import effect_of
+from ...numbers import format_value
 from ...response import loss_factor
 from ..fit import FitResult
 from .model import Model
@@ -59,6 +61,20 @@ class Step:
     @property
     def supported_by(self) -> list[str]:
         return [m for m, e in self.by_mode.items() if e["verdict"] == "supports"]
+
+    def parameter_words(self, mode: str) -> str:
+        """The fitted parameters in words, each with its unit (in ``mode``, or in the mode of the
+        rig the effect was found on) and its standard error, or "(not determined)":
+        ``mass = 0.509 kg ± 0.017 kg``; "no parameters" for an effect without any."""
+        spec = {p.name: p for p in effect_of(self.effect).parameters}
+        words = []
+        for name, value in self.parameters.items():
+            unit = spec[name.rpartition(".")[2]].unit_in(self.mode or mode)
+            error = self.standard_errors.get(name, math.nan)
+            words.append(f"{name} = {format_value(value, unit)}" + (
+                f" ± {format_value(error, unit, 'error')}" if math.isfinite(error)
+                else " (not determined)" if name in self.undetermined or math.isinf(error) else ""))
+        return ", ".join(words) or "no parameters"
 
     def report(self) -> dict:
         evidence = {"bic_drop": self.bic_drop, "candidates_bic_drop": self.candidates, **self.extra}
@@ -187,10 +203,7 @@ def summary(diagnosis: Diagnosis) -> str:
         lines[0] += f" (noise alone gives about {diagnosis.noise_gap:.4g})"
     lines.append(f"  where it disagrees: {diagnosis.where_baseline}")
     for n, s in enumerate(diagnosis.steps, 1):
-        params = ", ".join(f"{k} = {v:.4g}" + (f" ± {s.standard_errors[k]:.2g}" if math.isfinite(s.standard_errors.get(k, math.nan))
-                                                else " (not determined)" if k in s.undetermined
-                                                or math.isinf(s.standard_errors.get(k, math.nan)) else "")
-                           for k, v in s.parameters.items()) or "no parameters"
+        params = s.parameter_words(diagnosis.baseline.model.design.mode)
         support = s.support_words()
         lines.append(f"step {n}: add {s.effect} ({s.title}){' ' + support if s.mode else ''}: {params}; "
                      f"BIC drop {s.bic_drop:.1f}; gap {s.gap_before:.4g} -> {s.gap_after:.4g}"
