@@ -22,13 +22,14 @@ from .units import OPERATING_FREQUENCIES, amplitude_unit
 from .uploads import design_dropper, on_upload
 
 
-def tip(text: str, anchor: str = "top_center") -> Tooltip:
+def tip(text: str, anchor: str = "top_center", width: int = 420) -> Tooltip:
     """A button's description, shown when the pointer rests on it, centred on ``anchor`` of the
-    button (a Bokeh anchor: above it for ``top_*``, below for ``bottom_*``), placed where it
-    hides no other button: Panel's default, to its right, covered the next button of its row
-    (issue #27)."""
+    button (a Bokeh anchor: above it for ``top_*``, below for ``bottom_*``), at most ``width``
+    pixels wide, placed where it hides no other button of its row and stays in the window:
+    Panel's default, to its right, covered the next button of its row, and a long one ran past
+    the window's edge (issue #27)."""
     return Tooltip(content=text, position=anchor, attachment="above" if anchor.startswith("top") else "below",
-                   stylesheets=[":host { white-space: initial; max-width: 420px; }"])
+                   stylesheets=[f":host {{ white-space: initial; max-width: {width}px; }}"])
 
 
 class FloatInput(pn.widgets.FloatInput):
@@ -160,7 +161,7 @@ class DesignInputs(pn.viewable.Viewer):
         self.preset.param.watch(self._pick_preset, "value")
         state.param.watch(lambda e: setattr(self.preset, "value", shown_preset(e.new)), "design")
         self.mode = pn.widgets.RadioButtonGroup.from_param(
-            state.param.mode, description=state.param.mode.doc, color="primary",
+            state.param.mode, description=tip(state.param.mode.doc, "bottom_center", 300), color="primary",
             variant="outline", sizing_mode="stretch_width",
         )
         self.finite_length = pn.widgets.Switch.from_param(state.param.finite_length, margin=(8, 4, 0, 10))

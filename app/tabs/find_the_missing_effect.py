@@ -84,10 +84,13 @@ class DiagnosisView(pn.viewable.Viewer):
                                          description=tip("Synthetic data with an effect hidden in it (or none); "
                                          "its bushing goes into the explorer. The truth is shown after the diagnosis.", "bottom_center"))
         self.mystery.on_click(lambda _e: state.load_mystery())
-        self.baseline = pn.widgets.CheckButtonGroup.from_param(state.param.baseline, color="primary",
-                                                               variant="outline")
+        # the descriptions above the choice of branches and below the button: each of the row's
+        # controls visible while the pointer rests on the other
+        self.baseline = pn.widgets.CheckButtonGroup.from_param(state.param.baseline, color="primary", variant="outline",
+                                                               description=tip(state.param.baseline.doc, "top_right", 300))
         self.run = pn.widgets.Button(label="Diagnose", color="primary",
-                                     description=tip("Fit the baseline and every candidate effect; name what is missing."))
+                                     description=tip("Fit the baseline and every candidate effect; name what is missing.",
+                                                     "bottom_center"))
         self.run.on_click(self._click)
         # the progress (a bar and the step) in the text of one pane of a fixed height beside the
         # button: a widget shown and hidden, a button's state changed or the page's height changed

@@ -69,16 +69,16 @@ class MeasuredView(PlotView):
         self.example.on_click(self._load_example)
         self.clear = pn.widgets.Button(label="Clear the data", color="light")
         self.clear.on_click(lambda _e: state.clear_measured())
-        self.fit_button = pn.widgets.Button(label="Fit the five material parameters", color="primary",
-                                            description=tip("A global fit from 8 starting points, the current design first.",
-                                                            "top_right"))
+        # no description on hover: every side of the button has a control it would hide; the
+        # intro says what it does
+        self.fit_button = pn.widgets.Button(label="Fit the five material parameters", color="primary")
         self.fit_button.on_click(self._fit)
         # while a fit runs: where it is (issue #27 item 12), replaced by its result in one push
         self.fit_progress = pn.indicators.Progress(value=0, max=100, visible=False, sizing_mode="stretch_width",
                                                    height=12)
         self.fit_progress_text = pn.pane.HTML("", sizing_mode="stretch_width")
         fit.param.watch(self._on_fit_progress, ["running", "progress", "progress_message"])
-        self.method = pn.widgets.RadioButtonGroup.from_param(fit.param.fit_method, description=fit.param.fit_method.doc)
+        self.method = pn.widgets.RadioButtonGroup.from_param(fit.param.fit_method, description=tip(fit.param.fit_method.doc, "top_right", 300))
         self.fit_on = pn.widgets.TextInput.from_param(fit.param.fit_on, description=fit.param.fit_on.doc,
                                                       placeholder="e.g. mode=axial,amplitude=0.1 (amplitudes in mm or rad)", max_length=500,
                                                       sizing_mode="stretch_width")
@@ -286,8 +286,8 @@ class MeasuredView(PlotView):
                 "Load measured dynamic stiffness (and, if you have one, a quasi-static loop) as CSV "
                 "files (drop a file on its area or browse for it, up to 20 MB; the formats are in the About tab), or the "
                 "synthetic example. The points appear over the model in the Explorer tab; the "
-                f"residuals (model − measured) are below. **Fit** identifies {FITTED} with standard "
-                "errors and 95 % intervals, and says which parameters the data cannot determine; "
+                f"residuals (model − measured) are below. **Fit** identifies {FITTED} (a global fit from "
+                "several starting points, the current design's first) with standard errors and 95 % intervals, and says which parameters the data cannot determine; "
                 "then take the fitted design into the explorer or save it.",
                 sizing_mode="stretch_width"),
             pn.Row(pn.Column("**Stiffness CSV** (one or several)", self.stiffness_file, sizing_mode="stretch_width"),

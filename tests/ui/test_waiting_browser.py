@@ -225,12 +225,15 @@ def test_find_designs_shows_where_the_search_is_until_its_result(page, explorer_
     expect(page.get_by_text(re.compile("Searching: "))).to_have_count(0)
 
 
-# (tab, button, the start of its description)
+# (tab, button, the start of its description): buttons, and a button of each group of them
 DESCRIBED = (
-    ("Measured data and fit", "Fit the five material parameters", "8 starting points"),
+    ("Explorer", "torsion", "Axial: the sleeves moved apart"),
+    ("Measured data and fit", "two-step", "Global: all five parameters"),
     ("Find the missing effect", "Load a mystery data set (demo)", "Synthetic data with an effect"),
+    ("Find the missing effect", "fractional", "The branches the starting model has"),
     ("Find the missing effect", "Diagnose", "Fit the baseline and every candidate"),
 )
+SIZES = ((1280, 720), (1600, 1000))
 
 
 def overlap(a: dict, b: dict) -> bool:
@@ -238,10 +241,14 @@ def overlap(a: dict, b: dict) -> bool:
             and a["y"] < b["y"] + b["height"] and b["y"] < a["y"] + a["height"])
 
 
+@pytest.mark.parametrize("size", SIZES, ids=[f"{w}x{h}" for w, h in SIZES])
 @pytest.mark.parametrize(("tab", "button", "description"), DESCRIBED)
-def test_a_buttons_description_covers_no_other_button(page, explorer_url, tab, button, description):
-    """The pointer resting on a button shows its description where it hides no other button
-    (once: to its right, over the next button of its row)."""
+def test_a_buttons_description_covers_no_other_button(page, explorer_url, tab, button, description, size):
+    """The pointer resting on a button shows its description wholly in the window, where it
+    hides no other button nor any field of the button's row (once: to its right, over the next
+    button of its row; the mode's ran past the window's edge over the explorer's buttons, the
+    branches' covered *Diagnose*, the fit method's the *Fit on* field)."""
+    page.set_viewport_size({"width": size[0], "height": size[1]})
     open_explorer(page, explorer_url)
     page.get_by_text(tab, exact=True).click()
     hovered = page.get_by_role("button", name=button, exact=True)
@@ -251,9 +258,13 @@ def test_a_buttons_description_covers_no_other_button(page, explorer_url, tab, b
     shown = page.get_by_text(description).first
     expect(shown).to_be_visible()
     box = shown.bounding_box()
+    assert box["x"] >= 0 and box["y"] >= 0 and box["x"] + box["width"] <= size[0] and box["y"] + box["height"] <= size[1], box
     own = hovered.bounding_box()
     covered = [(b.inner_text() or b.evaluate("e => e.outerHTML.slice(0, 160)")) for b in page.get_by_role("button").all()
                if b.is_visible() and (other := b.bounding_box()) and other != own and overlap(box, other)]
+    row = {**own, "x": 0, "width": size[0]}  # the fields level with the button
+    covered += [f.evaluate("e => e.outerHTML.slice(0, 160)") for f in page.locator("input, select, textarea").all()
+                if f.is_visible() and (other := f.bounding_box()) and overlap(row, other) and overlap(box, other)]
     assert covered == [], covered
 
 
