@@ -45,7 +45,7 @@ def test_a_diagnosis_in_the_tab_holds_the_core_numbers(app):
     view, state = app.diagnosis, app.diagnosis.state
     assert view.run.disabled  # nothing to diagnose yet
     assert state.load_csv(inertia_csv(), "inertia.csv")
-    assert not view.run.disabled and "150 points" in view.source.object and "axial 150 points at 5 amplitude(s)" in view.source.object
+    assert not view.run.disabled and "150 points" in view.source.object and "axial 150 points at 5 amplitudes" in view.source.object
     run(app)
     r = state.result
     assert r.added == ["inertia"] and state.message == "" and not state.running
@@ -160,7 +160,7 @@ def test_data_of_two_modes_are_diagnosed_jointly_and_plotted_in_the_explorers_mo
     app.state.mode = "torsion"
     state, view = app.diagnosis.state, app.diagnosis
     assert state.load_csv(combined(parts, "axial").to_csv(), "two.csv")
-    assert "axial 150 points at 5 amplitude(s); torsion 60 points at 2 amplitude(s)" in view.source.object
+    assert "axial 150 points at 5 amplitudes; torsion 60 points at 2 amplitudes" in view.source.object
     run(app)
     r = state.result
     assert r.added == ["inertia"] and r.steps[0].mode == "axial" and not r.modes_disagree

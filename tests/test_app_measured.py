@@ -1,6 +1,7 @@
 """The explorer's measured-data tab without a browser: files loaded, drawn over the model and
 refused with their reasons; the fits in the session against the core's."""
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -134,6 +135,9 @@ def test_a_fit_the_data_cannot_determine_says_so_in_the_app(app):
     fc = next(line for line in table.splitlines() if line.startswith("| m "))
     assert [cell.strip() for cell in fc.split("|")[1:-1]].count("–") == 3
     assert "no linearised standard error or correlation for µ, σ_fmax, ε½" in table
+    cells = [c.strip() for line in table.splitlines()[3:] if line.startswith("| ") for c in line.split("|")[2:-1]]
+    assert cells and all(c == "–" or re.fullmatch(r"[+−]\d\.\d\d|0\.00", c) for c in cells), cells
+    assert "-" not in "".join(cells)  # a true minus sign, no "-0.00"
 
 
 def test_fit_without_data_says_so(app):

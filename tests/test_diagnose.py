@@ -211,6 +211,9 @@ def test_describe_says_where_and_which_way():
     text = describe(data, k, "axial", 0.001)
     assert text.startswith("loss factor: model too low at every frequency, from 0.17 mm up")
     assert describe(data, k_data, "axial", 0.001) == "no misfit above the noise."
+    # both: a sentence each, the second capitalised after its full stop ("… %). loss factor:" read as one)
+    both = describe(data, k * (1 + 0.08 * (ff / 100) ** 2), "axial", 0.001)
+    assert both.startswith("|K|: model too stiff from ") and ". Loss factor: model too low" in both
 
 
 def test_diagnose_refuses_a_bad_baseline():

@@ -344,8 +344,9 @@ class DiagnosisView(pn.viewable.Viewer):
         if s.data is not None:
             d = s.data
             modes = d.modes(s.explorer.design.mode).astype(str)
-            per_mode = [f"{m} {int(np.sum(modes == m))} points at {np.unique(d.amplitude[modes == m]).size} "
-                        f"amplitude(s)" for m in np.unique(modes)]
+            counts = {m: np.unique(d.amplitude[modes == m]).size for m in np.unique(modes)}
+            per_mode = [f"{m} {int(np.sum(modes == m))} points at {n} amplitude{'s' if n != 1 else ''}"
+                        for m, n in counts.items()]
             self.source.object = (f"**Data**: {s.source}: {len(d)} points, {format_number(d.frequency_hz.min(), 'frequency')}–"
                                   f"{format_value(d.frequency_hz.max(), 'Hz', 'frequency')}; {'; '.join(per_mode)}.")
         else:

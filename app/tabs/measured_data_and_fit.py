@@ -51,6 +51,14 @@ log = logging.getLogger("bushing.app")
 FITTED = " and ".join([", ".join(BY_NAME[p].symbol for p in MATERIAL[:-1]), BY_NAME[MATERIAL[-1]].symbol])
 
 
+def _correlation(value: float) -> str:
+    """A correlation coefficient to two decimals with a true minus sign, 0.00 unsigned (it read
+    "-0.00"); "–" where it is not defined."""
+    if not np.isfinite(value):
+        return "–"
+    text = f"{value:+.2f}"
+    return "0.00" if text[1:] == "0.00" else text.replace("-", "−")
+
 
 class MeasuredView(PlotView):
     """Upload, fit and residuals."""
@@ -259,7 +267,7 @@ class MeasuredView(PlotView):
                 "|---" * (len(MATERIAL) + 1) + "|"]
         for a in MATERIAL:
             corr.append(f"| {BY_NAME[a].symbol} | " + " | ".join(
-                f"{r.correlation[a][b]:+.2f}" if np.isfinite(r.correlation[a][b]) else "–" for b in MATERIAL) + " |")
+                _correlation(r.correlation[a][b]) for b in MATERIAL) + " |")
         flat = [BY_NAME[p].symbol for p in MATERIAL if not np.isfinite(r.standard_errors[p])]
         if flat:  # the linearised errors cannot be formed along a direction the data do not fix
             corr.append(f"\n– : no linearised standard error or correlation for {', '.join(flat)}: the data fix no "

@@ -145,4 +145,5 @@ def describe(data: MeasuredStiffness, model_k: np.ndarray, mode: str, noise_sd: 
             return describe(data, model_k, mode, noise_sd, level=2.0)
         return "no misfit above the noise."
     phrases.sort(reverse=True)
-    return ". ".join(p for _, p in phrases) + "."
+    texts = [p for _, p in phrases]  # a sentence each; the first follows the caller's colon
+    return ". ".join([texts[0], *(t[:1].upper() + t[1:] for t in texts[1:])]) + "."
