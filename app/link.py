@@ -295,15 +295,31 @@ class UrlLink:
             self._changed()
 
     def _changed(self, *_events):
+        """A change: the URL written ``delay_ms`` after the change has been handled, unless
+        another comes first. The wait starts on the event loop's next turn, after the whole
+        change (its plots included): started at the change, a change handled more slowly than
+        the wait (a loaded machine) let the URL be written between two changes that came
+        together, one history entry each."""
         if self.doc is None:  # no session (a script): at once
             self.write()
             return
-        if self._next is not None:
+        self._cancel()
+        self._next = self.doc.add_next_tick_callback(self._arm)
+
+    def _arm(self):
+        self._next = self.doc.add_timeout_callback(self.write, self.delay_ms)
+
+    def _cancel(self):
+        if self._next is None:
+            return
+        try:
+            self.doc.remove_timeout_callback(self._next)
+        except ValueError:
             try:
-                self.doc.remove_timeout_callback(self._next)
+                self.doc.remove_next_tick_callback(self._next)
             except ValueError:
                 pass  # it has just run
-        self._next = self.doc.add_timeout_callback(self.write, self.delay_ms)
+        self._next = None
 
     def write(self):
         """Put the state's linked values in the URL now (an unchanged URL is no change)."""

@@ -9,6 +9,7 @@ from urllib.parse import parse_qsl
 import panel as pn
 import pytest
 from bokeh.document import Document
+from bokeh.server.callbacks import NextTickCallback
 
 from app.link import URL_NAMES, design_query
 from app.main import URL_DELAY_MS, App
@@ -35,8 +36,18 @@ def opened(search: str) -> App:
     return app
 
 
+def turn(doc: Document) -> None:
+    """The event loop's next turn: the document's next-tick callbacks run (a change handled, the
+    link's pause starts)."""
+    for callback in [c for c in doc.session_callbacks if isinstance(c, NextTickCallback)]:
+        doc.remove_next_tick_callback(callback)
+        callback.callback()
+
+
 def flush(doc: Document) -> int:
-    """Run the document's waiting timeouts (the pause ends); how many there were."""
+    """The loop's next turn, then the document's waiting timeouts run (the pause ends); how
+    many timeouts there were."""
+    turn(doc)
     waiting = list(doc.session_callbacks)
     for callback in waiting:
         doc.remove_timeout_callback(callback)
@@ -73,7 +84,10 @@ def test_quick_changes_write_the_url_once_and_nothing_echoes(session):
         app.state.shear_modulus_mpa = value
     app.state.amplitude = 0.2
     assert writes == [] and len(changes) == 5  # within the pause: the URL waits
-    assert [c.timeout for c in session.session_callbacks] == [URL_DELAY_MS]
+    # the pause starts once the changes are handled (the loop's next turn), however long that took
+    assert [type(c) for c in session.session_callbacks] == [NextTickCallback]
+    turn(session)
+    assert writes == [] and [c.timeout for c in session.session_callbacks] == [URL_DELAY_MS]
     assert flush(session) == 1 and len(writes) == 1 and len(changes) == 5  # one write; no echo into the state
     assert (url()["mu_MPa"], url()["amp"]) == ("2.8", "0.2")
     assert flush(session) == 0
