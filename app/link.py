@@ -312,13 +312,10 @@ class UrlLink:
     def _cancel(self):
         if self._next is None:
             return
-        try:
+        try:  # Bokeh removes a session callback of either kind by this one call
             self.doc.remove_timeout_callback(self._next)
         except ValueError:
-            try:
-                self.doc.remove_next_tick_callback(self._next)
-            except ValueError:
-                pass  # it has just run
+            pass  # it has just run
         self._next = None
 
     def write(self):

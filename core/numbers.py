@@ -98,6 +98,15 @@ def format_value(value, unit: str = "", quantity: str | int | None = None) -> st
     return text if not unit or unit == "–" or text == "–" else f"{text} {unit}"
 
 
+def format_signed(value: float, decimals: int = 2) -> str:
+    """A signed number to ``decimals`` decimals with a true minus sign (``+0.41``, ``−0.99``),
+    zero unsigned (never ``-0.00``); ``–`` for None, NaN or an infinity."""
+    if value is None or not math.isfinite(float(value)):
+        return "–"
+    text = f"{float(value):+.{decimals}f}"
+    return text[1:] if float(text) == 0 else text.replace("-", "−")
+
+
 def format_change(fraction: float) -> str:
     """A relative change as people read it: signed percent to 3 significant digits (``−1.48 %``,
     ``+0.512 %``), ``0 %`` below 0.001 %."""

@@ -12,7 +12,7 @@ import panel as pn
 import param
 
 from core import PAPER_B
-from core.numbers import format_number, format_value
+from core.numbers import format_number, format_signed, format_value
 from core.parameters import BY_NAME, MATERIAL
 from core.synthetic import paper_b_example
 
@@ -49,15 +49,6 @@ log = logging.getLogger("bushing.app")
 
 
 FITTED = " and ".join([", ".join(BY_NAME[p].symbol for p in MATERIAL[:-1]), BY_NAME[MATERIAL[-1]].symbol])
-
-
-def _correlation(value: float) -> str:
-    """A correlation coefficient to two decimals with a true minus sign, 0.00 unsigned (it read
-    "-0.00"); "–" where it is not defined."""
-    if not np.isfinite(value):
-        return "–"
-    text = f"{value:+.2f}"
-    return "0.00" if text[1:] == "0.00" else text.replace("-", "−")
 
 
 class MeasuredView(PlotView):
@@ -267,7 +258,7 @@ class MeasuredView(PlotView):
                 "|---" * (len(MATERIAL) + 1) + "|"]
         for a in MATERIAL:
             corr.append(f"| {BY_NAME[a].symbol} | " + " | ".join(
-                _correlation(r.correlation[a][b]) for b in MATERIAL) + " |")
+                format_signed(r.correlation[a][b]) for b in MATERIAL) + " |")
         flat = [BY_NAME[p].symbol for p in MATERIAL if not np.isfinite(r.standard_errors[p])]
         if flat:  # the linearised errors cannot be formed along a direction the data do not fix
             corr.append(f"\n– : no linearised standard error or correlation for {', '.join(flat)}: the data fix no "
