@@ -362,3 +362,67 @@ def test_a_page_closed_during_the_fit_leaves_no_traceback(page, context, explore
     assert ended.wait(120)
     assert server_log.tracebacks() == []
     assert not [r for r in server_log.records if "WebSocketClosed" in r.getMessage()]
+
+
+# in the page: the placeholders of the tabs whose content the page does not hold (a Spacer each, in
+# the tabs' shadow root; the inactive tabs' are laid out too, hidden): whether each is shown, the
+# text its ::before writes, its height and the animation of its bar (::after)
+PLACEHOLDERS_JS = """() => {
+  const out = [];
+  const visit = (root) => {
+    for (const el of root.querySelectorAll('*')) {
+      if (el.classList.contains('bk-Spacer')) {
+        const box = el.getBoundingClientRect();
+        out.push({shown: box.width > 0 && box.height > 0
+                         && el.checkVisibility({visibilityProperty: true, opacityProperty: true}),
+                  text: getComputedStyle(el, '::before').content, height: box.height,
+                  moving: getComputedStyle(el, '::after').animationName});
+      }
+      if (el.shadowRoot) visit(el.shadowRoot);
+    }
+  };
+  visit(document);
+  return out;
+}"""
+SHOWN_PLACEHOLDERS_JS = f"() => ({PLACEHOLDERS_JS})().filter(p => p.shown)"
+
+
+@pytest.fixture
+def gated_tab(monkeypatch):
+    """The Slices tab's view built only once the test releases it: ``(reached, release)``."""
+    from app.main import App
+
+    reached, release = threading.Event(), threading.Event()
+
+    def held(build):
+        def gated(app):
+            reached.set()
+            release.wait(60)
+            return build(app)
+        return gated
+
+    monkeypatch.setattr(App, "LAZY_TABS", tuple((title, name, held(build) if name == "slices" else build)
+                                                for title, name, build in App.LAZY_TABS))
+    return reached, release
+
+
+def test_a_tab_being_built_says_so_until_it_is_shown(page, explorer_url, gated_tab):
+    """A tab opened for the first time is built on the server (the Slices tab: 1.3–1.9 s before
+    its figures were drawn, a blank page meanwhile): until its content replaces it, the page says
+    the tab is opening, with a moving bar (the only one that moves)."""
+    reached, release = gated_tab
+    open_explorer(page, explorer_url)
+    page.get_by_text("Slices", exact=True).click()
+    try:
+        assert reached.wait(60)  # the server builds the tab now, and is held there
+        page.wait_for_function(f"() => ({SHOWN_PLACEHOLDERS_JS})().length === 1")
+        placeholders = page.evaluate(PLACEHOLDERS_JS)
+        shown = [p for p in placeholders if p["shown"]]
+        assert shown[0]["text"] == '"Opening the tab…"' and shown[0]["height"] >= 40
+        assert shown[0]["moving"] == "bushing-opening"
+        # the hidden tabs' bars stand still (moving, they restyled the page at every frame)
+        assert {p["moving"] for p in placeholders if not p["shown"]} == {"none"}
+    finally:
+        release.set()
+    expect(page.get_by_text("Paper A splits the rubber")).to_be_visible()
+    assert page.evaluate(SHOWN_PLACEHOLDERS_JS) == []
