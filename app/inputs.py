@@ -11,6 +11,7 @@ from bokeh.models import CustomJSTickFormatter, Tooltip
 
 from core.bushing import STRUCTURAL_EFFECTS, shape_factor
 from core.io.design_file import loads_design_upload
+from core.numbers import format_change
 from core.parameters import DEFAULT_SHAPE
 from core.rules import RuleError
 
@@ -240,7 +241,7 @@ def shape_comparison(design) -> str:
         return "Torsion: the closed form is exact at any length (the finite-element S agrees)."
     used = "finite-element" if design.shape_kind == "finite" else "long-bushing formula"
     return (f"Finite-length S is {finite / long:.3f} of the long-bushing formula "
-            f"({100 * (finite / long - 1):+.1f} %); in use: the {used}.")
+            f"({format_change(finite / long - 1)}); in use: the {used}.")
 
 
 def status_banner(state: ExplorerState):

@@ -38,6 +38,7 @@ PLAIN_LOW, PLAIN_HIGH = 1e-4, 1e7
 LINK_DIGITS = 9
 _SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 _FROM_SUPERSCRIPT = str.maketrans("⁻⁰¹²³⁴⁵⁶⁷⁸⁹", "-0123456789")
+MINUS = "−"  # a negative number's sign as people read it (U+2212), not the hyphen-minus
 
 
 def digits_of(quantity: str | int | None) -> int:
@@ -63,7 +64,8 @@ def _positional(value: float, digits: int) -> str:
 def format_number(value, quantity: str | int | None = None) -> str:
     """``value`` (a real number in its unit) as people read it: the significant digits of
     ``quantity`` (:data:`DIGITS`, or a number of digits), positional in [1e-4, 1e7), else
-    engineering notation (``15×10⁻⁶``); ``–`` for None, NaN or an infinity."""
+    engineering notation (``15×10⁻⁶``), a negative number with a true minus sign (``−0.5``);
+    ``–`` for None, NaN or an infinity."""
     if value is None:
         return "–"
     value = float(value)
@@ -72,12 +74,12 @@ def format_number(value, quantity: str | int | None = None) -> str:
     digits = digits_of(quantity)
     value = rounded(value, digits)
     if value == 0.0 or PLAIN_LOW <= abs(value) < PLAIN_HIGH:
-        return _positional(value, digits)
+        return _positional(value, digits).replace("-", MINUS)
     exponent = 3 * math.floor(math.log10(abs(value)) / 3)
     mantissa = rounded(value / 10.0 ** exponent, digits)
     if abs(mantissa) >= 1000:  # rounding carried it over: 999.95×10³ → 1×10⁶
         mantissa, exponent = rounded(mantissa / 1000, digits), exponent + 3
-    return f"{_positional(mantissa, digits)}×10{str(exponent).translate(_SUPERSCRIPT)}"
+    return f"{_positional(mantissa, digits).replace('-', MINUS)}×10{str(exponent).translate(_SUPERSCRIPT)}"
 
 
 def format_outside(value, low: float, high: float, quantity: str | int | None = None) -> str:
@@ -104,7 +106,16 @@ def format_signed(value: float, decimals: int = 2) -> str:
     if value is None or not math.isfinite(float(value)):
         return "–"
     text = f"{float(value):+.{decimals}f}"
-    return text[1:] if float(text) == 0 else text.replace("-", "−")
+    return text[1:] if float(text) == 0 else text.replace("-", MINUS)
+
+
+def format_signed_number(value: float, quantity: str | int | None = None) -> str:
+    """:func:`format_number` with a sign, a true minus sign (``+0.52``, ``−0.0012``), zero
+    unsigned; ``–`` for None, NaN or an infinity."""
+    text = format_number(None if value is None else abs(float(value)), quantity)
+    if text == "–" or float(value) == 0.0 or text.strip("0.") == "":
+        return text
+    return (MINUS if float(value) < 0 else "+") + text
 
 
 def format_change(fraction: float) -> str:
@@ -113,7 +124,7 @@ def format_change(fraction: float) -> str:
     pct = 100.0 * float(fraction)
     if abs(pct) < 1e-3:
         return "0 %"
-    return ("−" if pct < 0 else "+") + format_number(abs(pct), 3) + " %"
+    return format_signed_number(pct, 3) + " %"
 
 
 def link_number(value) -> str:
@@ -134,9 +145,9 @@ def link_number(value) -> str:
 def parse_number(text, what: str = "") -> float:
     """The number a typed text gives; RuleError whose words name the text otherwise. Takes what
     :func:`core.rules.decimal` takes, and engineering notation as :func:`format_number` writes it
-    (``15×10⁻⁶``, or ``15x10^-6``)."""
+    (``15×10⁻⁶``, or ``15x10^-6``), with a true minus sign or a hyphen."""
     raw = str(text).strip()
-    plain = raw
+    plain = raw.replace(MINUS, "-")
     for sep in ("×10", "x10", "X10", "*10"):
         if sep in plain:
             mantissa, _, exponent = plain.partition(sep)
@@ -188,3 +199,5 @@ let m = Number((v / Math.pow(10, e)).toPrecision(digits));
 if (Math.abs(m) >= 1000) { m = Number((m / 1000).toPrecision(digits)); e += 3; }
 return plain(m) + "×10" + String(e).split("").map((c) => sup[c]).join("");
 """.replace("PLAIN_LOW", repr(PLAIN_LOW)).replace("PLAIN_HIGH", repr(PLAIN_HIGH))
+# … a negative tick with a true minus sign, as format_number writes it
+TICK_JS = f"const text = (() => {{ {TICK_JS} }})();\nreturn text.replace(/^-/, \"{MINUS}\");\n"

@@ -5,6 +5,7 @@ test_app_page)."""
 import csv
 import io
 import logging
+import re
 
 import numpy as np
 import pytest
@@ -194,6 +195,9 @@ def test_slices_view_holds_the_core_numbers(app):
     k3 = stiffness(PAPER_B, app.state.frequency_hz, x, slices=3).magnitude[:, 0]
     assert_allclose(data["magnitude_diff_pct"][3], 100 * (k3 / k1 - 1), rtol=1e-9)
     assert "3 slices" in app.slices.summary(data)
+    # the largest difference of 3 slices, signed with a true minus sign (it read "-0.32 %")
+    worst = data["magnitude_diff_pct"][3][np.argmax(np.abs(100 * (k3 / k1 - 1)))]
+    assert worst < 0 and f"| 3 slices | −{abs(worst):.2f} % at " in app.slices.summary(data)
     app.tabs.active = 1  # shown: its figures hold the same numbers
     x, k = xy(app.slices.frame("magnitude"), "3 slices")
     assert_allclose(k, stiffness(PAPER_B, app.state.frequency_hz, x * 1e-3, slices=3).magnitude[:, 0] / 1e6, rtol=1e-12)
@@ -237,6 +241,8 @@ def test_comparison_with_a_pinned_reference(app):
     _, ref_loop = data(app.plots.frame("loop"), "reference")
     assert_allclose(ref_loop * 1.1, data(app.plots.frame("loop"), "total")[1], rtol=1e-12)
     assert "+10.00 %" in app.compare.text.object
+    s.length_mm = 81.0  # −10 %, with a true minus sign (issue #27, item 7)
+    assert "−10.00 %" in app.compare.text.object and not re.search(r"-\d", app.compare.text.object)
     s.clear_reference()
     assert comparison() is None
     assert "reference" not in [el.label for el in overlay(app, "magnitude", "frequency")]

@@ -42,6 +42,8 @@ def test_the_finite_length_switch_and_its_comparison(app):
     g = s.design.geometry
     ratio = shape_factor(g, "axial", "finite") / shape_factor(g, "axial", "long")
     assert f"{ratio:.3f} of the long-bushing formula" in app.inputs.shape_note.object
+    # the change as a percentage with a true minus sign (it read "(-3.6 %)", issue #27 item 7)
+    assert ratio < 1 and f"(−{100 * (1 - ratio):.3g} %)" in app.inputs.shape_note.object
     s.finite_length = True
     assert s.design.shape == "finite" and "in use: the finite-element" in app.inputs.shape_note.object
     x, y = xy(app.plots.frame(("magnitude", "amplitude")), "operating point")

@@ -3,6 +3,7 @@ sensitivities (against finite differences and the closed forms), designs found f
 
 import itertools
 import json
+import re
 
 import numpy as np
 import pandas as pd
@@ -20,7 +21,7 @@ from core.parameters import MATERIAL as PARAMETERS
 from core.registry import parameter
 from core.response import loss_factor
 from core.synthetic import synthetic_stiffness
-from core.whatif.sensitivity import elasticities, log_derivatives, sentence
+from core.whatif.sensitivity import elasticities, log_derivatives, ranked, sentence
 from core.whatif.target import TargetError, solve
 from core.whatif.tolerance import (
     FitCovariance,
@@ -204,6 +205,14 @@ def test_the_sentence_names_what_dominates():
     text = sentence(elasticities(PAPER_B, 10.0, 1e-4))
     # each parameter named in words (issue #27: "follows a most" read as English)
     assert text.startswith("|K| depends most on the inner radius a (") and "the loss factor depends most on the" in text
+    # the elasticities signed with a true minus sign (issue #27, item 7: one formatter), from the
+    # numbers ranked: b's is negative (K falls as b/a grows, eq 18), and so is µ's on the loss factor
+    values = elasticities(PAPER_B, 10.0, 1e-4)
+    (_, e2) = ranked(values, "magnitude")[1]
+    (_, d1) = ranked(values, "loss_factor")[0]
+    assert e2 < 0 and f"then on the outer radius b (−{abs(e2):.2f} %)" in text
+    assert d1 < 0 and f"moves it by −{abs(d1) / 100:.2g})" in text
+    assert not re.search(r"-\d", text)
 
 
 # ---- designs from targets ---------------------------------------------------------------------

@@ -8,7 +8,7 @@ import holoviews as hv
 import panel as pn
 import param
 
-from core.numbers import format_number, format_value
+from core.numbers import format_number, format_signed, format_value
 
 from .. import curves, units
 from ..bands import band_tolerances, banded
@@ -97,8 +97,8 @@ def band_words(p: dict, unit: str) -> str:
 
 
 def pct(value: float) -> str:
-    """A signed percentage to 2 decimals, without a "-0.00" from round-off."""
-    return f"{0.0 if abs(value) < 0.005 else value:+.2f} %"
+    """A signed percentage to 2 decimals, a true minus sign, without a "−0.00" from round-off."""
+    return f"{format_signed(value, 2)} %"
 
 
 class CompareView(PlotView):

@@ -14,7 +14,7 @@ from core.card import CARD_MODES
 from core.effects import EFFECTS, effect_title
 from core.identify.diagnose import BIC_THRESHOLD
 from core.material import ConvergenceError
-from core.numbers import format_number, format_value
+from core.numbers import format_number, format_signed, format_value
 
 from ..diagnosis_state import DiagnosisState
 from ..inputs import tip
@@ -383,7 +383,7 @@ class DiagnosisView(pn.viewable.Viewer):
             lines.append("> " + _effect_card(step.effect))
             others = sorted(((v, k) for k, v in step.candidates.items() if k != step.effect), reverse=True)[:3]
             if others:
-                lines.append("Other candidates' BIC drops: " + ", ".join(f"{effect_title(k)} {v:.1f}"
+                lines.append("Other candidates' BIC drops: " + ", ".join(f"{effect_title(k)} {format_signed(v, 1)}"
                                                                          for v, k in others) + ".")
         if not r.steps:
             lines.append("**Nothing added**: no effect of the library is supported by the data.")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import panel as pn
 
-from core.numbers import format_value
+from core.numbers import format_signed, format_value
 
 from ..curves import amplitude_grid, branch_breakdown, padded, slice_comparison
 from ..live import LivePlot
@@ -52,8 +52,8 @@ class SlicesView(PlotView):
             if s in data["magnitude_diff_pct"]:
                 dm, de = data["magnitude_diff_pct"][s], data["loss_factor_diff_pct"][s]
                 im, ie = int(np.argmax(np.abs(dm))), int(np.argmax(np.abs(de)))
-                rows.append(f"| {self.NAMES[s]} | {dm[im]:+.2f} % at {format_value(xs[im], unit, 'amplitude')} "
-                            f"| {de[ie]:+.2f} % at {format_value(xs[ie], unit, 'amplitude')} |")
+                rows.append(f"| {self.NAMES[s]} | {format_signed(dm[im], 2)} % at {format_value(xs[im], unit, 'amplitude')} "
+                            f"| {format_signed(de[ie], 2)} % at {format_value(xs[ie], unit, 'amplitude')} |")
         missing = [self.NAMES[s] for s in (2, 3, "continuum") if s not in data["magnitude"]]
         design = self.state.design
         if data["refused"]:

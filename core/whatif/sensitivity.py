@@ -18,6 +18,7 @@ import numpy as np
 
 from ..bushing import stiffness_points
 from ..design import Design
+from ..numbers import format_signed, format_signed_number
 from ..parameters import BY_NAME, NAMES
 from ..response import loss_factor
 
@@ -68,9 +69,9 @@ def sentence(values: dict[str, dict[str, float]]) -> str:
     (l1, d1) = ranked(values, "loss_factor")[0]
     n1, n2, n3 = (_named(n) for n in (k1, k2, l1))
     s1, s3 = BY_NAME[k1].symbol, BY_NAME[l1].symbol
-    return (f"|K| depends most on {n1} (+1 % in {s1} gives {e1:+.2f} % in |K|), then on "
-            f"{n2} ({e2:+.2f} %); the loss factor depends most on {n3} "
-            f"(+1 % in {s3} moves it by {d1 / 100:+.2g}).")
+    return (f"|K| depends most on {n1} (+1 % in {s1} gives {format_signed(e1, 2)} % in |K|), then on "
+            f"{n2} ({format_signed(e2, 2)} %); the loss factor depends most on {n3} "
+            f"(+1 % in {s3} moves it by {format_signed_number(d1 / 100, 2)}).")
 
 
 def _named(name: str) -> str:

@@ -83,7 +83,7 @@ def test_what_ifs_refuse_a_tolerance_of_95_and_a_typo_with_a_message(page, explo
     expect(message).to_contain_text("89 %")
     expect(box).to_have_value("95")  # not silently set back to 89 or 0
     enter(box, "-5")
-    expect(message).to_contain_text("-5 %")
+    expect(message).to_contain_text("−5 %")  # as the one formatter writes it: a true minus sign
     enter(page.get_by_label("Length L ± %"), "3")  # a good one is taken…
     page.wait_for_url(re.compile(r"tol=L(%3A|:)3"))
     assert "mu" not in dict(parse_qsl(urlsplit(page.url).query)).get("tol", "")  # …the refused ones never were
@@ -173,3 +173,5 @@ def test_tick_labels_are_written_without_e_notation(page, explorer_url):
     labels = [label for texts in ticks.values() for label in texts]
     assert labels and all(labels), ticks
     assert [t for t in labels if E_NOTATION.search(t)] == [], ticks
+    # a negative tick (the residuals') with a true minus sign, as every text writes it
+    assert any(t.startswith("−") for t in labels) and [t for t in labels if "-" in t] == [], ticks

@@ -155,7 +155,8 @@ def test_the_diagnosis_names_its_candidates(page, explorer_url, tmp_path):
     line = page.get_by_text("Other candidates' BIC drops:").first
     line.wait_for(timeout=120_000)
     listed = line.inner_text().split(":", 1)[1].strip().rstrip(".")
-    names = [re.sub(r"\s+-?\d+(\.\d+)?$", "", item.strip()) for item in listed.split(", ")]
+    # each with its drop, signed with a true minus sign where the candidate's BIC rose
+    names = [re.sub(r"\s+[+−]?\d+(\.\d+)?$", "", item.strip()) for item in listed.split(", ")]
     titles = {e.title for e in EFFECTS.values()}
     assert names and all(n in titles for n in names), names
 
