@@ -2,6 +2,7 @@
 core's band, the sensitivity bars against the core, the design form's search and its adoption."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -127,6 +128,16 @@ def test_the_design_form_says_when_targets_cannot_be_met(app):
     v.form.run()
     assert not v.form.found.feasible and "cannot be met" in v.result.object and "closest" in v.result.object
     assert v.use.label == "Take the closest into the explorer"
+    # the statement in the form's units and words (issue #27, item 5), not the file's SI: the
+    # target as typed, what the closest reaches in kN/mm, the misses with a true minus sign, the
+    # limits that bind in mm by their symbols
+    statement = v.result.object.split("**")[1]
+    assert "axial |K| = 400 kN/mm at 10 Hz, 0.1 mm is missed by −" in statement
+    reached = re.search(r"\(it reaches ([0-9.]+) kN/mm\)", statement)
+    closest = v.form.found.closest
+    assert float(reached.group(1)) == pytest.approx(closest.achieved[0] / 1e6, rel=5e-3)
+    assert "b − a ≥ 5 mm" in statement and "L ≤ 100 mm" in statement
+    assert not re.search(r"e[+-]\d|N/m\b|0\.0001 m|thickness|length|outer_radius|-\d", statement)
 
 
 def test_tolerances_travel_in_a_link(app):

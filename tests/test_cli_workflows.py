@@ -273,7 +273,7 @@ def test_contradicting_targets_are_said_to_contradict_each_other(tmp_path):
     assert high["value"] == pytest.approx(reached, rel=1e-9)
     assert low["miss"] == pytest.approx(reached / 5e6 - 1, rel=1e-9)
     assert high["miss"] == pytest.approx(reached / 4e6 - 1, rel=1e-9)
-    assert f"missed by {100 * low['miss']:+.3g} % (it reaches {reached:.4g})" in line
+    assert f"missed by {100 * low['miss']:+.3g} % (it reaches {reached:.4g} N/m)" in line
     # without -o the report itself goes to standard output, and nothing else
     plain, again = design_run(tmp_path, problem, output=False)
     assert plain.returncode == 0 and again["statement"] == line
@@ -296,4 +296,4 @@ def test_targets_beyond_the_limits_name_the_limits_that_bind(tmp_path):
     stiffest = {**START, "geometry": {"inner_radius": 0.02, "outer_radius": 0.022, "length": 0.1}}
     limit = magnitude_at(tmp_path, stiffest)
     assert closest["targets"][0]["value"] == pytest.approx(limit, rel=1e-6)
-    assert f"(it reaches {limit:.4g})" in line
+    assert f"(it reaches {limit:.4g} N/m)" in line

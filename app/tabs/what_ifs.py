@@ -10,9 +10,10 @@ import panel as pn
 import param
 
 from core.card import CARD_MODES
-from core.numbers import format_number, format_value
+from core.numbers import format_change, format_number, format_value
 from core.parameters import BY_NAME, GEOMETRY, MODE, NAMES
 from core.whatif.sensitivity import elasticities, sentence
+from core.whatif.target import Words
 from core.whatif.tolerance import ToleranceError
 
 from .. import curves, units
@@ -228,7 +229,7 @@ class WhatIfView(PlotView):
             self.result.object = f"**Cannot search**: {message}" if message else ""
             self.solutions.visible = self.use.visible = False
             return
-        lines = [f"**{found.statement}** ({found.seconds:.2f} s)"]
+        lines = [f"**{found.words(WORDS)}** ({found.seconds:.2f} s)"]
         rows = self.form.rows()
         if rows:
             targets = found.problem.targets
@@ -240,9 +241,6 @@ class WhatIfView(PlotView):
                 name = f"{i}" if found.solutions else "closest"
                 lines.append(f"| {name} | {found_values(sol.design, ' | ')} | {got} |")
             lines += [""] + [f"Target {j}: {target_words(t)}." for j, t in enumerate(targets, 1)]
-        for sol in rows[:1]:  # the limits the statement names, in the fields' units
-            for item in sol.binding:
-                lines[0] = lines[0].replace(item, limit_words(item))
         self.result.object = "\n".join(lines)
         self.solutions.options = {f"{i}: {found_values(s.design, ', ', GEOMETRY, symbols=True)} {A.unit.display}": i - 1
                                   for i, s in enumerate(rows, 1)}
@@ -309,14 +307,24 @@ def target_words(target) -> str:
 
 def limit_words(item: str) -> str:
     """A limit a found design sits on, as the core words it (``outer_radius ≤ 0.04``, SI), in the
-    field's display unit (``b ≤ 40 mm``); a limit of no design parameter as it is."""
+    form's words and display unit (``b ≤ 40 mm``, ``b − a ≥ 2 mm``); anything else as it is."""
     name, _, rest = item.partition(" ")
     op, _, value = rest.partition(" ")
-    p = BY_NAME.get(name)
+    unit = _B.unit if name == "thickness" else BY_NAME[name].unit if name in BY_NAME else None
     try:
         number = float(value)
     except ValueError:
         return item
-    if p is None:
+    if unit is None:
         return item
-    return f"{p.symbol} {op} {format_value(p.unit.to_display(number), p.unit.display, 'size')}"
+    return f"{variable_name(name)} {op} {format_value(unit.to_display(number), unit.display, FOUND_COLUMNS.get(name, 'size'))}"
+
+
+def variable_name(name: str) -> str:
+    """A searched variable as the form names it: a design parameter by its symbol (``b``, ``µ``),
+    the rubber's thickness as ``b − a``."""
+    return f"{_B.symbol} − {A.symbol}" if name == "thickness" else BY_NAME[name].symbol
+
+
+# the statement of a search in the form's words and units, by the one formatter
+WORDS = Words(target_words, shown_measure, limit_words, format_change, variable_name)

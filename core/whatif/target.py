@@ -85,11 +85,7 @@ class Target:
         """The target in words (``axial |K| = 4.5e+06 N/m at 10 Hz, 0.0001 m``). ``value``,
         ``amplitude`` and ``frequency`` write its numbers (functions of the SI value, and of the mode
         for an amplitude, to text with its unit); by default SI to 4 significant digits."""
-        def si(v):
-            unit = "" if self.is_ratio or self.quantity == "loss_factor" else f" {MODE[self.modes[0]].stiffness.si}"
-            return f"{v:.4g}{unit}"
-
-        value = value or si
+        value = value or self.si
         amplitude = amplitude or (lambda x, m: f"{x:.4g} {MODE[m].amplitude.si}")
         frequency = frequency or (lambda f: f"{f:.4g} Hz")
         amp = " and ".join(amplitude(x, m) for m, x in zip(self.modes, self.amplitudes))
@@ -101,6 +97,12 @@ class Target:
             goal = " and ".join(p for p in ((f"≥ {value(self.low)}" if self.low is not None else ""),
                                             (f"≤ {value(self.high)}" if self.high is not None else "")) if p)
         return f"{what} {goal} at {frequency(self.frequency_hz)}, {amp}"
+
+    def si(self, value: float) -> str:
+        """A value of the target's quantity in SI to 4 significant digits, with its unit
+        (``4.5e+06 N/m``; a loss factor or a ratio without one)."""
+        unit = "" if self.is_ratio or self.quantity == "loss_factor" else f" {MODE[self.modes[0]].stiffness.si}"
+        return f"{value:.4g}{unit}"
 
     def misses(self, value: float) -> float:
         """How far ``value`` lies outside the target, relative (0 inside, or within
@@ -161,6 +163,23 @@ class Solution:
 
 
 @dataclass(frozen=True)
+class Words:
+    """How a search's statement writes its numbers and names: a target (:meth:`Target.describe`),
+    the value a design reaches for a target, a limit that binds (``outer_radius ≤ 0.04``, SI, as
+    :attr:`Solution.binding` gives it), a relative change (a fraction) and a searched variable's
+    name (``thickness``, a design parameter's or the thickness t = b − a)."""
+
+    target: Callable[[Target], str]
+    reached: Callable[[Target, float], str]
+    limit: Callable[[str], str]
+    change: Callable[[float], str]
+    name: Callable[[str], str]
+
+
+SI_WORDS = Words(Target.describe, Target.si, str, lambda fraction: f"{100 * fraction:+.3g} %", str)
+
+
+@dataclass(frozen=True)
 class Found:
     """What the search found: the feasible designs nearest the start (best first), or, when
     there are none, the closest miss and the statement why."""
@@ -168,12 +187,25 @@ class Found:
     problem: Problem
     solutions: list[Solution]
     closest: Solution | None
-    statement: str
     seconds: float
 
     @property
     def feasible(self) -> bool:
         return bool(self.solutions)
+
+    @property
+    def statement(self) -> str:
+        """What was found, in words, numbers in SI (:data:`SI_WORDS`): the report's and the
+        command line's."""
+        return self.words(SI_WORDS)
+
+    def words(self, words: Words) -> str:
+        """What was found, in words, its numbers and names written by ``words``: how many designs
+        meet the targets and how the nearest changes the start, or which targets the closest miss
+        misses by how much (what it reaches) and which limits bind there."""
+        if self.solutions:
+            return _found_words(self.problem, self.solutions, words)
+        return _why(self.problem, self.closest, words)
 
     def report(self) -> dict:
         out = {"feasible": self.feasible, "statement": self.statement,
@@ -314,18 +346,17 @@ def solve(problem: Problem, starts: int = STARTS, seed: int = 0,
             break
     solutions = sorted((_solution(problem, z) for z in found), key=lambda s: s.distance)[:problem.solutions]
     if solutions:
-        return Found(problem, solutions, None, _found_words(problem, solutions), time.perf_counter() - t0)
-    closest = _closest(problem, ev, points)
-    return Found(problem, [], closest, _why(problem, closest), time.perf_counter() - t0)
+        return Found(problem, solutions, None, time.perf_counter() - t0)
+    return Found(problem, [], _closest(problem, ev, points), time.perf_counter() - t0)
 
 
-def _found_words(problem: Problem, solutions: list[Solution]) -> str:
+def _found_words(problem: Problem, solutions: list[Solution], words: Words) -> str:
     best = solutions[0]
     before, after = problem.values(problem.start), problem.values(best.design)
-    changes = ", ".join(f"{n} {100 * (after[n] / before[n] - 1):+.3g} %" for n in problem.variables
+    changes = ", ".join(f"{words.name(n)} {words.change(after[n] / before[n] - 1)}" for n in problem.variables
                         if abs(after[n] / before[n] - 1) > 1e-9) or "nothing"
     count = "1 design meets" if len(solutions) == 1 else f"{len(solutions)} designs meet"
-    binding = f"; the limits that bind there: {', '.join(best.binding)}" if best.binding else ""
+    binding = f"; the limits that bind there: {', '.join(map(words.limit, best.binding))}" if best.binding else ""
     return f"{count} every target. The nearest to the start changes {changes}{binding}."
 
 
@@ -373,13 +404,13 @@ def _closest_within_limits(ev: _Evaluator, points, lo, hi, n_limits: int) -> np.
     return best[1] if best is not None else np.clip(points[0], lo, hi)
 
 
-def _why(problem: Problem, closest: Solution) -> str:
-    missed = [f"{t.describe()} is missed by {100 * t.misses(v):+.3g} % (it reaches {v:.4g})"
+def _why(problem: Problem, closest: Solution, words: Words) -> str:
+    missed = [f"{words.target(t)} is missed by {words.change(t.misses(v))} (it reaches {words.reached(t, v)})"
               for t, v in zip(problem.targets, closest.achieved) if abs(t.misses(v)) > 1e-6]
     if not missed:
         missed = ["the drive of a target would strain the rubber beyond what it survives"]
     if closest.binding:
-        cause = f"the limits that bind there: {', '.join(closest.binding)}"
+        cause = f"the limits that bind there: {', '.join(map(words.limit, closest.binding))}"
     else:
         cause = "no limit binds there: the targets contradict each other"
     return f"The targets cannot be met. At the closest design, {'; '.join(missed)}; {cause}."
