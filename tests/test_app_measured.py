@@ -53,6 +53,10 @@ def test_measured_points_appear_over_the_model(app):
     assert_allclose(residuals["loss_factor_residual"], 0.0, atol=1e-9)
     assert residuals["gap"] == pytest.approx(1 / 11, rel=1e-6)  # |K_model − K_data| / |K_data| = 1 − 1/1.1
     assert_allclose(xy(app.measured.frame("magnitude", "amplitude"), "residual")[1], 100 * (1 / 1.1 - 1), rtol=1e-8)
+    # the key of the data plots' colours names the file's three amplitudes in mm, in the plots' order
+    # (issue #27, item 8: one colour per amplitude, as in the diagnosis)
+    key = re.sub(r"<[^>]+>", "", app.measured.curve_key.object)
+    assert key.split() == ["Amplitudes:", "■", "0.01", "mm", "■", "0.1", "mm", "■", "1", "mm"]
     app.tabs.active = 0
     assert app.state.load_measured_loop(loop_bytes, "l.csv")
     assert app.state.frequency_hz == pytest.approx(0.1) and app.state.amplitude == pytest.approx(1.0)

@@ -34,6 +34,19 @@ def sweep_label(value, unit) -> str:
     return format_value(value, unit, 3)
 
 
+def amplitude_key(groups: list, unit: str) -> str:
+    """The key of :func:`amplitude_curves`' colours, one amplitude each (``groups`` as
+    :func:`app.curves.amplitude_groups`, the amplitudes in ``unit``), as a line of HTML; empty
+    without groups. The plots carry no legend of their own: five amplitudes times data and models
+    would cover the curves."""
+    palette = SWEEP_PALETTES["amplitude"]
+    if not groups:
+        return ""
+    return "Amplitudes: " + " ".join(
+        f'<span style="color:{palette[i % len(palette)]};font-weight:bold">■ {sweep_label(g["amplitude"], unit)}</span>'
+        for i, g in enumerate(groups))
+
+
 BRANCH_COLORS = {"elastic": "#1f77b4", "viscoelastic": "#2ca02c", "friction": "#d62728"}
 
 

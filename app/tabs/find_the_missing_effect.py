@@ -20,7 +20,7 @@ from ..diagnosis_state import DiagnosisState
 from ..inputs import tip
 from ..live import LivePlot, one_change, update_or_keep
 from ..plotting.find_the_missing_effect import diagnosis_overlays, pending_overlays
-from ..plotting.style import SWEEP_PALETTES, sweep_label
+from ..plotting.style import amplitude_key
 from ..shapes import shape_pane
 from ..units import amplitude_unit
 from ..uploads import csv_dropper, on_upload, verdict_html
@@ -413,11 +413,7 @@ class DiagnosisView(pn.viewable.Viewer):
 
     def _draw(self, r):
         overlays = diagnosis_overlays(r)
-        palette = SWEEP_PALETTES["amplitude"]
-        unit = amplitude_unit(r.final.design.mode)
-        self.curve_key.object = "Amplitudes: " + " ".join(
-            f'<span style="color:{palette[i % len(palette)]};font-weight:bold">■ {sweep_label(g["amplitude"], unit)}</span>'
-            for i, g in enumerate(overlays["groups"]))
+        self.curve_key.object = amplitude_key(overlays["groups"], amplitude_unit(r.final.design.mode))
         self._plots(overlays)
 
     def __panel__(self):

@@ -22,7 +22,7 @@ from ..fit_state import FIT_DEPENDS, FitState
 from ..inputs import tip
 from ..live import LivePlot, one_change, update_or_keep
 from ..plotting.measured_data_and_fit import data_overlays, prediction_overlay, residual_overlays
-from ..plotting.style import ranged
+from ..plotting.style import amplitude_key, ranged
 from ..shapes import shape_pane
 from ..state import ExplorerState, measured_amplitudes
 from ..uploads import csv_dropper, on_files, on_upload, verdict_html
@@ -100,6 +100,7 @@ class MeasuredView(PlotView):
         # take (AttributeError, and the change lost)
         self.prediction_box = pn.Column(self.prediction, visible=False, sizing_mode="stretch_width")
         self.residuals: LivePlot | None = None
+        self.curve_key = pn.pane.HTML("", sizing_mode="stretch_width")  # which colour is which amplitude
         self.plots_box: pn.Column | None = None  # the plots, hidden (with the fit's controls) without data
         self._show_message()
         self._show_prediction()
@@ -236,8 +237,9 @@ class MeasuredView(PlotView):
         overlays = residual_overlays(points, residuals, dims)
         items = [data[k] for k in DATA] + [overlays[k] for k in RESIDUALS]
         self.residuals = LivePlot.shown(self.residuals, items)
+        self.curve_key.object = amplitude_key(groups, units.amplitude_unit(self.state.design.mode))
         if self.plots_box is None:
-            self.plots_box = pn.Column(self.residuals.grid(2), sizing_mode="stretch_width")
+            self.plots_box = pn.Column(self.curve_key, self.residuals.grid(2), sizing_mode="stretch_width")
         self.plots_box.visible = not empty
         self.how_to.visible = empty
 
