@@ -11,6 +11,7 @@ from core.effects import EFFECTS, effect_title
 from core.identify.diagnose import BRANCHES, Diagnosis, diagnose
 from core.identify.fit import fitted_name
 from core.io.table import csv_text
+from core.numbers import format_value
 from core.synthetic import MYSTERIES, Mystery
 
 from . import report_curves
@@ -126,7 +127,8 @@ class DiagnosisState(param.Parameterized):
             for eid in missing:
                 values = m.hidden.get(eid) or {p.name: getattr(m.design.material, p.name)
                                                for p in EFFECTS[eid].parameters}
-                shown = ", ".join(f"{k} = {v:.4g}" for k, v in values.items())
+                units = {p.name: p.unit_in(m.design.mode) for p in EFFECTS[eid].parameters}
+                shown = ", ".join(f"{k} = {format_value(v, units.get(k, ''))}" for k, v in values.items())
                 parts.append(f"**{EFFECTS[eid].title}** (`{eid}`{': ' + shown if shown else ''})")
             said = "Hidden in the data: " + " and ".join(parts) + "."
         if self.result is not None:

@@ -115,6 +115,11 @@ def test_the_mystery_demo_hides_then_reveals_the_truth(app):
     assert "Amplitude dependence (Fletcher–Gent effect)" in view.truth.object
     assert "found exactly that" in view.truth.object
     assert not view.reveal.visible
+    # the hidden values with their units (issue #27, item 5): Paper B's σ_fmax in Pa, ε½ a number
+    assert "friction_stress_max = 19200 Pa, friction_strain_half = 0.004)" in view.truth.object
+    state._next_mystery = 0  # a fixture mass hidden in axial data: in kg
+    state.load_mystery()
+    assert "(`inertia`: mass = 0.5 kg)" in state.truth()
 
 
 def test_bad_input_leaves_a_message_and_the_session_going(app):
