@@ -38,9 +38,17 @@ SELECT_JS = """(index) => {
   tabs.active = index;
 }"""
 
-# the document idle, the selected tab's content sent (not Panel's placeholder) and laid out, and
-# every figure shown (a figure view with a size on the page) painted
+# the document idle, the selected tab's content sent (not Panel's placeholder) and laid out, every
+# figure shown (a figure view with a size on the page) painted, and every drop area's words faded
+# in (FilePond fades them in from its own frame loop, which runs slowly while no drop area is used)
 DRAWN_JS = """() => {
+  const labels = [];
+  const walk = (root) => root.querySelectorAll('*').forEach(el => {
+    if (el.classList.contains('filepond--drop-label')) labels.push(el);
+    if (el.shadowRoot) walk(el.shadowRoot);
+  });
+  walk(document);
+  if (labels.some(el => el.offsetWidth > 0 && getComputedStyle(el).opacity !== '1')) return false;
   if (!(window.Bokeh && Bokeh.documents.length > 0 && Bokeh.documents[0].is_idle)) return false;
   const views = [...Bokeh.index.all_views()];
   const tabs = views.find(v => v.model.type.endsWith('Tabs'));
