@@ -70,7 +70,9 @@ def test_the_card_tab_holds_the_core_card(app):
     explorer_axial = stiffness(app.state.design, app.state.frequency_hz, 0.2e-3).magnitude[0, 0]
     assert rows[0]["mode"] == "axial" and rows[0]["magnitude"] == pytest.approx(explorer_axial, rel=1e-12)
     for r in rows:
-        assert format_number(units.display_stiffness(r['magnitude'], r['mode']), "stiffness") in view.table.object
+        # each number held to its unit: a narrow cell at 1280×720 broke "4.207 | kN/mm" over two lines
+        k = format_number(units.display_stiffness(r['magnitude'], r['mode']), "stiffness")
+        assert f"| {k}\u00a0{units.stiffness_unit(r['mode'])} |" in view.table.object
     radial = next(r for r in rows if r["mode"] == "radial")["magnitude"]
     axial = next(r for r in rows if r["mode"] == "axial")["magnitude"]
     assert f"radial / axial **{radial / axial:.2f}**" in view.table.object

@@ -108,9 +108,9 @@ class CardView(PlotView):
                 versus = f"{r['shape_factor'] / long_shape_factor(g.inner_radius, g.outer_radius, g.length, mode):.3f}"
             except ValueError:
                 versus = "no formula"
-            lines.append(f"| {mode} | {format_value(amp, units.amplitude_unit(mode), 'amplitude')} "
-                         f"| {format_number(k, 'stiffness')} {units.stiffness_unit(mode)} | {r['loss_factor']:.4f} "
-                         f"| {shape_used(design, mode)} | {format_value(r['shape_factor'], s_unit)} | {versus} "
+            lines.append(f"| {mode} | {kept(format_value(amp, units.amplitude_unit(mode), 'amplitude'))} "
+                         f"| {kept(format_value(k, units.stiffness_unit(mode), 'stiffness'))} | {r['loss_factor']:.4f} "
+                         f"| {shape_used(design, mode)} | {kept(format_value(r['shape_factor'], s_unit))} | {versus} "
                          f"| {format_change(bulk[mode][0])}, {format_change(bulk[mode][1])} |")
         k = design.material.bulk_modulus
         unit = BY_NAME["bulk_modulus"].unit
@@ -128,3 +128,9 @@ class CardView(PlotView):
         return pn.Column(pn.pane.Markdown(TEXT, sizing_mode="stretch_width"), shape_pane(self.state, CARD_MODES),
                          self.inputs, self.table,
                          self.plots.grid(2), sizing_mode="stretch_width")
+
+
+def kept(text: str) -> str:
+    """A number and its unit held on one line (a no-break space): a narrow table cell broke
+    ``4.207 kN/mm`` between them."""
+    return text.replace(" ", "\u00a0")
