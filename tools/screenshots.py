@@ -38,17 +38,9 @@ SELECT_JS = """(index) => {
   tabs.active = index;
 }"""
 
-# the document idle, the selected tab's content sent (not Panel's placeholder) and laid out, every
-# figure shown (a figure view with a size on the page) painted, and every drop area's words faded
-# in (FilePond fades them in from its own frame loop, which runs slowly while no drop area is used)
+# the document idle, the selected tab's content sent (not Panel's placeholder) and laid out, and
+# every figure shown (a figure view with a size on the page) painted
 DRAWN_JS = """() => {
-  const labels = [];
-  const walk = (root) => root.querySelectorAll('*').forEach(el => {
-    if (el.classList.contains('filepond--drop-label')) labels.push(el);
-    if (el.shadowRoot) walk(el.shadowRoot);
-  });
-  walk(document);
-  if (labels.some(el => el.offsetWidth > 0 && getComputedStyle(el).opacity !== '1')) return false;
   if (!(window.Bokeh && Bokeh.documents.length > 0 && Bokeh.documents[0].is_idle)) return false;
   const views = [...Bokeh.index.all_views()];
   const tabs = views.find(v => v.model.type.endsWith('Tabs'));
@@ -58,6 +50,22 @@ DRAWN_JS = """() => {
   if (child.el.getBoundingClientRect().height < 150) return false;  // a lazy tab: not yet filled
   const shown = v => { const r = v.el.getBoundingClientRect(); return r.width > 0 && r.height > 0; };
   return views.filter(v => v.model.type === 'Figure' && shown(v)).every(v => v.has_finished());
+}"""
+
+# no drop area's words halfway through a fade: FilePond fades them in from its own frame loop, which
+# runs slowly while no drop area is used (the shots caught them pale, as if disabled)
+WORDS_JS = """() => {
+  const labels = [];
+  const walk = (root) => root.querySelectorAll('*').forEach(el => {
+    if (el.classList.contains('filepond--drop-label')) labels.push(el);
+    if (el.shadowRoot) walk(el.shadowRoot);
+  });
+  walk(document);
+  // the words at rest: shown (opacity 1), or hidden while the area holds a file (0); FilePond writes
+  // their opacity from its first frame on (none yet, then 0 and up to 1)
+  const resting = el => el.style.opacity === '1' ||
+    (el.style.opacity === '0' && el.closest('.filepond--root')?.querySelector('.filepond--item') != null);
+  return labels.every(el => el.offsetWidth === 0 || resting(el));
 }"""
 
 SETTLE_JS = """() => Promise.all([...Bokeh.index.all_views()].map(v => v.ready))"""
@@ -113,6 +121,10 @@ def shoot(url: str, out: Path, sizes, chromium: str) -> list[Path]:
                     page.wait_for_function(DRAWN_JS, timeout=DRAW_TIMEOUT_MS if index else LOAD_TIMEOUT_MS)
                 except Exception:  # noqa: BLE001 - a tab still drawing is shot as it is, said
                     print(f"screenshots: {title!r} at {width}x{height} was not drawn in time (shot as it is)", file=sys.stderr)
+                try:
+                    page.wait_for_function(WORDS_JS, timeout=DRAW_TIMEOUT_MS)
+                except Exception:  # noqa: BLE001 - shot as it is, said
+                    print(f"screenshots: {title!r} at {width}x{height}: a drop area's words still fading", file=sys.stderr)
                 page.evaluate(SETTLE_JS)
                 path = folder / f"{index + 1:02d}-{slug(title)}.png"
                 page.screenshot(path=str(path))
