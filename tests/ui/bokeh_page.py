@@ -84,6 +84,16 @@ def plots(page) -> dict:
     return page.evaluate(PLOTS_JS)
 
 
+def drop_into(page, path, index: int = 0):
+    """Give ``path`` to the ``index``-th drop area of the tab shown (in the main area: the
+    sidebar's design-file area is shown as well). A tab's drop areas are made a moment after its
+    buttons, and a hidden tab's areas stay in the page: the page's last file input was, under
+    load, the sidebar's (the CSV refused there as "invalid type") or a hidden tab's."""
+    area = page.locator("#main .filepond--root").filter(visible=True).nth(index)
+    area.wait_for()
+    area.locator("input[type=file]").set_input_files(str(path))
+
+
 def settle(page, timeout=30_000):
     """Wait until every Bokeh view has painted what it had received when this was called."""
     token = page.evaluate(SETTLE_JS)

@@ -10,7 +10,14 @@ from pathlib import Path
 import numpy as np
 from playwright.sync_api import expect
 
-from tests.ui.bokeh_page import open_explorer, plots, settle, wait_plot, wait_plot_changed
+from tests.ui.bokeh_page import (
+    drop_into,
+    open_explorer,
+    plots,
+    settle,
+    wait_plot,
+    wait_plot_changed,
+)
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 TAB = "Measured data and fit"
@@ -74,7 +81,7 @@ def test_a_stiffness_file_in_mm_is_refused_alike_in_both_tabs(page, explorer_url
     assert "measured" not in plots(page)["|K| against frequency"]["legends"]
     page.get_by_text("Find the missing effect", exact=True).click()
     page.get_by_role("button", name="Diagnose").wait_for()
-    page.locator("#main input[type=file]").last.set_input_files(str(mm))
+    drop_into(page, mm)
     expect(page.locator(".diagnosis-error")).to_contain_text(said)
     assert page.get_by_role("button", name="Diagnose").is_disabled()
 

@@ -7,7 +7,7 @@ on all 90); after a pointer over a drop area, on at least a quarter (measured: 4
 import re
 from pathlib import Path
 
-from tests.ui.bokeh_page import open_explorer
+from tests.ui.bokeh_page import drop_into, open_explorer
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
@@ -65,7 +65,7 @@ def test_a_file_sent_is_complete_without_a_played_progress(page, explorer_url):
     page.get_by_role("button", name="Diagnose").wait_for()
     page.evaluate("""() => { window.bushingProgress = [];
       document.addEventListener('FilePond:processfileprogress', (e) => window.bushingProgress.push(e.detail.progress), true); }""")
-    page.locator("#main input[type=file]").last.set_input_files(str(EXAMPLES / "paper_b_stiffness.csv"))
+    drop_into(page, EXAMPLES / "paper_b_stiffness.csv")
     page.locator(".filepond--item[data-filepond-item-state='processing-complete']").last.wait_for()
     reported = page.evaluate("() => window.bushingProgress")
     assert all(p == 1 for p in reported), reported

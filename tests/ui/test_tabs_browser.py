@@ -9,6 +9,7 @@ import pytest
 from playwright.sync_api import expect
 
 from tests.ui.bokeh_page import (
+    drop_into,
     mystery_demo,
     open_explorer,
     plots,
@@ -116,7 +117,7 @@ def test_diagnose_a_hidden_effect_and_use_the_final_model(page, explorer_url, tm
     open_explorer(page, explorer_url)
     page.get_by_text("Find the missing effect", exact=True).click()
     page.get_by_role("button", name="Diagnose").wait_for()
-    page.locator("input[type=file]").last.set_input_files(str(measured))
+    drop_into(page, measured)
     page.get_by_text("150 points").first.wait_for()
     page.get_by_role("button", name="Diagnose").click()
     page.get_by_text("Step 1: add Apparent mass seen by the force sensor").wait_for(timeout=60_000)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from playwright.sync_api import expect
 
-from tests.ui.bokeh_page import FIGURE_JS, open_explorer
+from tests.ui.bokeh_page import FIGURE_JS, drop_into, open_explorer
 
 pytestmark = pytest.mark.usefixtures("console_errors", "no_server_tracebacks")
 
@@ -61,7 +61,7 @@ def upload_150_points(page, tmp_path):
                         noise=0.005, seed=3).to_csv(measured)
     page.get_by_text("Find the missing effect", exact=True).click()
     page.get_by_role("button", name="Diagnose").wait_for()
-    page.locator("input[type=file]").last.set_input_files(str(measured))
+    drop_into(page, measured)
     page.get_by_text("150 points").first.wait_for()
 
 
