@@ -113,7 +113,7 @@ def format_signed_number(value: float, quantity: str | int | None = None) -> str
     """:func:`format_number` with a sign, a true minus sign (``+0.52``, ``−0.0012``), zero
     unsigned; ``–`` for None, NaN or an infinity."""
     text = format_number(None if value is None else abs(float(value)), quantity)
-    if text == "–" or float(value) == 0.0 or text.strip("0.") == "":
+    if text == "–" or float(value) == 0.0:
         return text
     return (MINUS if float(value) < 0 else "+") + text
 

@@ -310,20 +310,29 @@ def limit_words(item: str) -> str:
     form's words and display unit (``b ≤ 40 mm``, ``b − a ≥ 2 mm``); anything else as it is."""
     name, _, rest = item.partition(" ")
     op, _, value = rest.partition(" ")
-    unit = _B.unit if name == "thickness" else BY_NAME[name].unit if name in BY_NAME else None
     try:
         number = float(value)
     except ValueError:
         return item
-    if unit is None:
+    if _variable(name) is None:
         return item
-    return f"{variable_name(name)} {op} {format_value(unit.to_display(number), unit.display, FOUND_COLUMNS.get(name, 'size'))}"
+    symbol, unit = _variable(name)
+    return f"{symbol} {op} {format_value(unit.to_display(number), unit.display, FOUND_COLUMNS.get(name, 'size'))}"
 
 
 def variable_name(name: str) -> str:
-    """A searched variable as the form names it: a design parameter by its symbol (``b``, ``µ``),
-    the rubber's thickness as ``b − a``."""
-    return f"{_B.symbol} − {A.symbol}" if name == "thickness" else BY_NAME[name].symbol
+    """A searched variable as the form names it (:func:`_variable`)."""
+    return _variable(name)[0]
+
+
+def _variable(name: str):
+    """A searched variable or a limited parameter as the form names it, with its unit: a design
+    parameter by its symbol (``b``, ``µ``), the rubber's thickness t as ``b − a`` in b's unit;
+    None for any other name."""
+    if name == "thickness":
+        return f"{_B.symbol} − {A.symbol}", _B.unit
+    p = BY_NAME.get(name)
+    return None if p is None else (p.symbol, p.unit)
 
 
 # the statement of a search in the form's words and units, by the one formatter
